@@ -1,0 +1,21 @@
+//! # verti-world
+//!
+//! Everything about *worlds and tasks* in verti: the immutable [`World`] description
+//! (elevation [`Heightfield`], semantic [`PatchGrid`], [`Obstacle`]s, [`Task`]s and their
+//! [`GlobalPath`]s), the procedural generator of the 100-world / 1000-task benchmark set, the
+//! versioned on-disk format, and the importer for original Verti-Bench worlds.
+
+pub mod error;
+pub mod heightfield;
+pub mod obstacle;
+pub mod scale;
+pub mod surface;
+pub mod world;
+
+pub use error::{Result, WorldError};
+pub use heightfield::Heightfield;
+pub use obstacle::{Face, Obstacle, ObstacleShape};
+pub use surface::{Patch, PatchGrid, SoilParams, Surface, TerrainClass};
+pub use world::{
+    ElevationLevel, GlobalPath, ObstacleDensity, Task, TaskId, TerrainType, World, WorldMeta, WorldSource,
+};

@@ -1,0 +1,72 @@
+//! World scale: every length in a world (cells, heights, obstacles, task circle, clearances)
+//! is multiplied by it so 1/6- and 1/10-scale vehicles get proportional worlds.
+
+use crate::error::{Result, WorldError};
+
+/// Parses a scale written as a decimal (`0.1`, `1`) or a fraction (`1/6`, `1/10`).
+/// Accepted range: (0, 10].
+pub fn parse_scale(text: &str) -> Result<f64> {
+    let t = text.trim();
+    let value = if let Some((num, den)) = t.split_once('/') {
+        let n: f64 = num
+            .trim()
+            .parse()
+            .map_err(|_| WorldError::Argument(format!("scale `{text}`: numerator `{num}` is not a number")))?;
+        let d: f64 = den
+            .trim()
+            .parse()
+            .map_err(|_| WorldError::Argument(format!("scale `{text}`: denominator `{den}` is not a number")))?;
+        if d == 0.0 {
+            return Err(WorldError::Argument(format!("scale `{text}`: denominator is zero")));
+        }
+        n / d
+    } else {
+        t.parse()
+            .map_err(|_| WorldError::Argument(format!("scale `{text}` is not a number or a fraction like 1/6")))?
+    };
+    check_scale(value)?;
+    Ok(value)
+}
+
+/// Rejects scales that are not finite or outside (0, 10].
+pub fn check_scale(value: f64) -> Result<()> {
+    if !value.is_finite() || value <= 0.0 || value > 10.0 {
+        return Err(WorldError::Argument(format!(
+            "scale {value} is out of range: it must be in (0, 10], e.g. 1, 1/6 or 1/10"
+        )));
+    }
+    Ok(())
+}
+
+/// A short label for file and set names: `1`, `1/6`, `1/10`, or the decimal.
+pub fn scale_label(value: f64) -> String {
+    for den in 1..=20u32 {
+        if (value * f64::from(den) - 1.0).abs() < 1e-9 {
+            return if den == 1 { "1".into() } else { format!("1/{den}") };
+        }
+    }
+    format!("{value}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_fractions_and_decimals() {
+        assert_eq!(parse_scale("1").unwrap(), 1.0);
+        assert!((parse_scale("1/6").unwrap() - 1.0 / 6.0).abs() < 1e-15);
+        assert_eq!(parse_scale(" 1/10 ").unwrap(), 0.1);
+        assert_eq!(parse_scale("0.25").unwrap(), 0.25);
+        assert_eq!(scale_label(1.0 / 6.0), "1/6");
+        assert_eq!(scale_label(0.1), "1/10");
+    }
+
+    #[test]
+    fn rejects_bad_scales() {
+        for bad in ["0", "-1", "1/0", "abc", "nan", "inf", "20", "1/x"] {
+            let e = parse_scale(bad).unwrap_err().to_string();
+            assert!(e.contains("scale"), "{bad}: {e}");
+        }
+    }
+}
