@@ -6,9 +6,14 @@
 //! versioned on-disk format, and the importer for original Verti-Bench worlds.
 
 pub mod error;
+pub mod format;
+pub mod generate;
 pub mod heightfield;
+pub mod npy;
 pub mod obstacle;
+pub mod paths;
 pub mod scale;
+pub mod stats;
 pub mod surface;
 pub mod world;
 

@@ -1,0 +1,1 @@
+//! Statistics of world sets (filled in by the stats work).
