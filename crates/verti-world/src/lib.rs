@@ -9,15 +9,18 @@ pub mod error;
 pub mod format;
 pub mod generate;
 pub mod heightfield;
+pub mod import_vb;
 pub mod npy;
 pub mod obstacle;
 pub mod paths;
 pub mod scale;
+pub mod sets;
 pub mod stats;
 pub mod surface;
 pub mod world;
 
 pub use error::{Result, WorldError};
+pub use npy::read_array2;
 pub use heightfield::Heightfield;
 pub use obstacle::{Face, Obstacle, ObstacleShape};
 pub use surface::{Patch, PatchGrid, SoilParams, Surface, TerrainClass};
