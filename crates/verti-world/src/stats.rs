@@ -6,7 +6,6 @@
 //! Everything is plain data with stable snake_case field names so the JSON output can be
 //! compared across versions; [`fmt::Display`] gives the compact text report.
 
-use crate::generate::elevation::shape_stats;
 use crate::surface::{Surface, TerrainClass};
 use crate::world::{ElevationLevel, MAX_RELIEF_FULL_SCALE, ObstacleDensity, TerrainType, World};
 use serde::Serialize;
@@ -253,9 +252,12 @@ fn level_elevation(worlds: &[World], level: ElevationLevel, scale: f64) -> Level
     let mine: Vec<&World> = worlds.iter().filter(|w| w.meta.level == level).collect();
     for w in &mine {
         let h = w.terrain.heights();
-        let shape = shape_stats(h, w.terrain.size());
-        reliefs.push(shape.relief);
-        stds.push(shape.std);
+        // Not `elevation::shape_stats`: its autocorrelation lags need at least 9 vertices per
+        // side, and any valid heightfield (2x2 and up) must work here.
+        let len = h.len() as f64;
+        let m = h.iter().sum::<f64>() / len;
+        reliefs.push(w.terrain.max_height() - w.terrain.min_height());
+        stds.push((h.iter().map(|v| (v - m).powi(2)).sum::<f64>() / len).sqrt());
         for &v in h {
             n += 1;
             sum += v;
