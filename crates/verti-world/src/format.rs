@@ -175,7 +175,7 @@ pub fn save_world(world: &World, dir: &Path) -> Result<()> {
             paths: world.paths.iter().zip(&world.tasks).map(|(p, t)| PathSpec { pair: t.pair, points: p.points.clone() }).collect(),
         },
     };
-    let text = serde_norway::to_string(&manifest)
+    let text = crate::yaml::to_yaml(&manifest)
         .map_err(|e| WorldError::invalid(dir.join(MANIFEST), "manifest", format!("cannot serialise: {e}")))?;
     let header = "# verti world manifest (format verti-world v1). Heights: elevation.npy; labels: labels.npy.\n";
     std::fs::write(dir.join(MANIFEST), format!("{header}{text}")).map_err(|e| WorldError::io(dir.join(MANIFEST), e))
@@ -371,7 +371,7 @@ pub fn save_set(worlds: &[World], name: &str, seed: Option<u64>, dir: &Path, pro
         scale: worlds.first().map(|w| w.meta.scale).unwrap_or(1.0),
         worlds: worlds.iter().map(|w| world_dir_name(w.meta.index)).collect(),
     };
-    let text = serde_norway::to_string(&manifest).map_err(|e| WorldError::invalid(dir.join(SET_MANIFEST), "manifest", e.to_string()))?;
+    let text = crate::yaml::to_yaml(&manifest).map_err(|e| WorldError::invalid(dir.join(SET_MANIFEST), "manifest", e.to_string()))?;
     std::fs::write(dir.join(SET_MANIFEST), text).map_err(|e| WorldError::io(dir.join(SET_MANIFEST), e))
 }
 

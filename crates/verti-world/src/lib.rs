@@ -18,6 +18,7 @@ pub mod sets;
 pub mod stats;
 pub mod surface;
 pub mod world;
+pub mod yaml;
 
 pub use error::{Result, WorldError};
 pub use npy::read_array2;

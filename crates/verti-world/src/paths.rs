@@ -84,13 +84,17 @@ impl<'a> PlanningGrid<'a> {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// True when every point of the segment keeps the clearance.
+    /// True when every point of the segment keeps the clearance. Samples are at most
+    /// `step` apart and must clear `clearance + step / 2`: the footprint distance is
+    /// 1-Lipschitz, so every point between two samples then clears `clearance` exactly.
     pub fn segment_clear(&self, a: [f64; 2], b: [f64; 2]) -> bool {
         let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
         let steps = (len / (0.2 * self.cell)).ceil().max(1.0) as usize;
+        let step = len / steps as f64;
+        let needed = self.clearance + 0.5 * step;
         (0..=steps).all(|i| {
             let t = i as f64 / steps as f64;
-            self.clearance_at(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])) >= self.clearance
+            self.clearance_at(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])) >= needed
         })
     }
 

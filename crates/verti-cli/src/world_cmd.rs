@@ -1,0 +1,238 @@
+//! `verti world ...`
+
+use crate::progress::bar;
+use clap::{Args, Subcommand};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use verti_world::format::{save_set, save_world};
+use verti_world::generate::{SetConfig, generate_set, set_name};
+use verti_world::import_vb::{ImportOptions, import_vb, scan_vb_dir};
+use verti_world::paths::DEFAULT_CLEARANCE;
+use verti_world::scale::parse_scale;
+use verti_world::sets::{resolve_set, resolve_world};
+use verti_world::{World, WorldError};
+
+pub type CmdResult = Result<(), Box<dyn std::error::Error>>;
+
+#[derive(Subcommand)]
+pub enum WorldCommand {
+    /// Generate a world set (default: the built-in verti-100 set, seed 0).
+    Generate(GenerateArgs),
+    /// Import original Verti-Bench worlds (one config, or a whole folder with --dir).
+    ImportVb(ImportArgs),
+    /// Print a summary of one world (a world directory or SET:INDEX, e.g. verti-100:42).
+    Show(ShowArgs),
+}
+
+#[derive(Args)]
+pub struct ScaleArg {
+    /// World scale: 1, 1/6, 1/10 or any decimal in (0, 10]. Every length is multiplied by it.
+    #[arg(long, default_value = "1", value_parser = scale_parser)]
+    pub scale: f64,
+}
+
+fn scale_parser(s: &str) -> Result<f64, String> {
+    parse_scale(s).map_err(|e| e.to_string())
+}
+
+#[derive(Args)]
+pub struct GenerateArgs {
+    /// Set seed; the same seed gives byte-identical files on every machine.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Number of worlds (10 tasks each).
+    #[arg(long, default_value_t = 100)]
+    count: u32,
+    #[command(flatten)]
+    scale: ScaleArg,
+    /// Clearance global paths keep from obstacles, full-scale metres (scaled with the world).
+    #[arg(long, default_value_t = DEFAULT_CLEARANCE)]
+    clearance: f64,
+    /// Output directory (default: worlds/<set name>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Overwrite an existing non-empty output directory.
+    #[arg(long)]
+    force: bool,
+}
+
+#[derive(Args)]
+pub struct ImportArgs {
+    /// A Verti-Bench `configN_LEVEL.yaml` (omit with --dir).
+    config: Option<PathBuf>,
+    /// The world's 129x129 heightmap (`worldN.bmp`).
+    #[arg(long)]
+    heightmap: Option<PathBuf>,
+    /// Optional `labelsN_LEVEL.npy`, cross-checked against the config's patches.
+    #[arg(long)]
+    labels: Option<PathBuf>,
+    /// Import every configN_LEVEL.yaml of this folder (heightmaps and labels found by name).
+    #[arg(long, conflicts_with_all = ["config", "heightmap", "labels"])]
+    dir: Option<PathBuf>,
+    #[command(flatten)]
+    scale: ScaleArg,
+    /// Path clearance from obstacles, full-scale metres.
+    #[arg(long, default_value_t = DEFAULT_CLEARANCE)]
+    clearance: f64,
+    /// Output: a world directory (one config) or a set directory (--dir).
+    #[arg(long)]
+    out: PathBuf,
+    /// Overwrite an existing non-empty output directory.
+    #[arg(long)]
+    force: bool,
+}
+
+#[derive(Args)]
+pub struct ShowArgs {
+    /// A world directory or SET:INDEX (e.g. verti-100:42).
+    world: String,
+    #[command(flatten)]
+    scale: ScaleArg,
+}
+
+pub fn run(cmd: WorldCommand) -> CmdResult {
+    match cmd {
+        WorldCommand::Generate(a) => generate(a),
+        WorldCommand::ImportVb(a) => import(a),
+        WorldCommand::Show(a) => show(a),
+    }
+}
+
+/// Refuses to write into a non-empty directory unless forced, so a typo never clobbers data.
+fn check_out_dir(out: &Path, force: bool) -> Result<(), WorldError> {
+    if out.exists() && !force && out.read_dir().map(|mut d| d.next().is_some()).unwrap_or(true) {
+        return Err(WorldError::Argument(format!("{} exists and is not empty (use --force to overwrite)", out.display())));
+    }
+    if force && out.exists() {
+        std::fs::remove_dir_all(out).map_err(|e| WorldError::io(out, e))?;
+    }
+    Ok(())
+}
+
+fn generate(a: GenerateArgs) -> CmdResult {
+    let config = SetConfig { seed: a.seed, count: a.count, scale: a.scale.scale, clearance: a.clearance };
+    config.validate()?;
+    let name = set_name(&config);
+    let out = a.out.unwrap_or_else(|| PathBuf::from("worlds").join(&name));
+    check_out_dir(&out, a.force)?;
+    let t0 = Instant::now();
+    let pb = bar(u64::from(a.count), "generating");
+    let worlds = generate_set(&config, &|| pb.inc(1))?;
+    pb.finish_and_clear();
+    let t_gen = t0.elapsed();
+    let pb = bar(u64::from(a.count), "writing");
+    save_set(&worlds, &name, Some(a.seed), &out, &|| pb.inc(1))?;
+    pb.finish_and_clear();
+    println!(
+        "generated {} ({} worlds, {} tasks) in {:.2} s, written to {} in {:.2} s",
+        name,
+        worlds.len(),
+        worlds.iter().map(|w| w.tasks.len()).sum::<usize>(),
+        t_gen.as_secs_f64(),
+        out.display(),
+        (t0.elapsed() - t_gen).as_secs_f64()
+    );
+    print_composition(&worlds);
+    Ok(())
+}
+
+fn print_composition(worlds: &[World]) {
+    println!("  levels: {}", count_by(worlds, |w| w.meta.level));
+    println!("  types: {}", count_by(worlds, |w| w.meta.terrain_type));
+    println!("  densities: {}", count_by(worlds, |w| w.meta.density));
+}
+
+/// "a 3, b 5" counts of a key over worlds, in key order.
+fn count_by<K: Ord + std::fmt::Display>(worlds: &[World], key: impl Fn(&World) -> K) -> String {
+    let mut counts = std::collections::BTreeMap::new();
+    for w in worlds {
+        *counts.entry(key(w)).or_insert(0usize) += 1;
+    }
+    counts.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ")
+}
+
+fn import(a: ImportArgs) -> CmdResult {
+    let opts = ImportOptions { scale: a.scale.scale, clearance: a.clearance, index: None };
+    check_out_dir(&a.out, a.force)?;
+    if let Some(dir) = a.dir {
+        let files = scan_vb_dir(&dir)?;
+        let pb = bar(files.len() as u64, "importing");
+        let worlds = {
+            use rayon::prelude::*;
+            files
+                .par_iter()
+                .map(|f| {
+                    let w = import_vb(&f.config, &f.heightmap, f.labels.as_deref(), &opts);
+                    pb.inc(1);
+                    w
+                })
+                .collect::<Result<Vec<_>, _>>()?
+        };
+        pb.finish_and_clear();
+        let name = format!("vb-{}", dir.file_name().and_then(|n| n.to_str()).unwrap_or("import"));
+        save_set(&worlds, &name, None, &a.out, &|| {})?;
+        println!("imported {} Verti-Bench worlds into {}", worlds.len(), a.out.display());
+        print_composition(&worlds);
+        return Ok(());
+    }
+    let config = a.config.ok_or_else(|| WorldError::Argument("give a CONFIG.yaml with --heightmap, or --dir FOLDER".into()))?;
+    let heightmap = a.heightmap.ok_or_else(|| WorldError::Argument("--heightmap WORLD.bmp is required with a config".into()))?;
+    let w = import_vb(&config, &heightmap, a.labels.as_deref(), &opts)?;
+    save_world(&w, &a.out)?;
+    println!("imported {} into {}", w.meta.name, a.out.display());
+    Ok(())
+}
+
+fn show(a: ShowArgs) -> CmdResult {
+    let w = resolve_world(&a.world, a.scale.scale)?;
+    print!("{}", describe(&w));
+    Ok(())
+}
+
+/// A short multi-line description of a world.
+pub fn describe(w: &World) -> String {
+    let mut classes = std::collections::BTreeMap::new();
+    for p in w.patches.patches() {
+        *classes.entry(p.class).or_insert(0) += 1;
+    }
+    let rocks = w.obstacles.iter().filter(|o| o.is_rock()).count();
+    let mut s = format!(
+        "{}  (index {}, scale {})\n  level {}  type {}  density {}\n  terrain {:.1} m x {:.1} m, heights {:.2}..{:.2} m (max height {:.2} m)\n  classes: {}\n  obstacles: {} rocks, {} trees\n  tasks: {}\n",
+        w.meta.name,
+        w.meta.index,
+        verti_world::scale::scale_label(w.meta.scale),
+        w.meta.level,
+        w.meta.terrain_type,
+        w.meta.density,
+        2.0 * w.terrain.half_extent(),
+        2.0 * w.terrain.half_extent(),
+        w.terrain.min_height(),
+        w.terrain.max_height(),
+        w.meta.max_height,
+        classes.iter().map(|(c, n)| format!("{c} {n}")).collect::<Vec<_>>().join(", "),
+        rocks,
+        w.obstacles.len() - rocks,
+        w.tasks.len()
+    );
+    for (t, p) in w.tasks.iter().zip(&w.paths) {
+        s.push_str(&format!(
+            "    pair {}: ({:.1}, {:.1}) -> ({:.1}, {:.1}), path {:.1} m{}\n",
+            t.pair,
+            t.start[0],
+            t.start[1],
+            t.goal[0],
+            t.goal[1],
+            p.length(),
+            if p.points.is_empty() { " (no path)" } else { "" }
+        ));
+    }
+    s
+}
+
+/// Resolves a set for commands that take one, with a progress bar.
+pub fn load_set_with_progress(spec: &str, scale: f64) -> Result<verti_world::sets::WorldSet, WorldError> {
+    let pb = bar(0, "loading");
+    let set = resolve_set(spec, scale, &|| pb.inc(1));
+    pb.finish_and_clear();
+    set
+}
