@@ -1,0 +1,154 @@
+//! Deformable soil: Chrono's Soil Contact Model (SCM) on a node grid, physics_spec §1.
+//!
+//! Nodes sit at `(i·δ, j·δ)` with δ = 0.1 m × world scale. Each node remembers its plastic
+//! sinkage and the largest Bekker pressure it has carried (`sigma_yield`). Under a wheel the
+//! vertical ray from the node meets the wheel cylinder; the total sinkage gives an elastic
+//! trial pressure `K_e·(z − z_plastic)`; above the yield pressure the node follows Bekker's
+//! `(K_c/b + K_φ)·zⁿ` and the plastic sinkage grows. Unloading and reloading are elastic, so
+//! ruts persist and later wheels roll in them.
+//!
+//! Storage is copy-on-write: the grid is a table of optional 32x32-node chunks behind `Arc`s,
+//! and the table itself is behind an `Arc`. Cloning a [`SoilState`] copies one pointer; the
+//! first write after a clone copies the table (pointers only) and the one chunk written. Only
+//! nodes under wheels are ever visited, so the cost per step does not depend on the map size.
+
+use std::sync::Arc;
+
+/// Nodes per chunk side.
+pub const CHUNK: usize = 32;
+const CHUNK_NODES: usize = CHUNK * CHUNK;
+
+/// Per-node memory of one chunk (f32: millimetre-scale quantities, half the memory to copy).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chunk {
+    /// Plastic sinkage along the undeformed normal [m].
+    pub plastic: [f32; CHUNK_NODES],
+    /// Largest pressure carried so far [Pa].
+    pub yield_pressure: [f32; CHUNK_NODES],
+}
+
+impl Default for Chunk {
+    fn default() -> Self {
+        Chunk { plastic: [0.0; CHUNK_NODES], yield_pressure: [0.0; CHUNK_NODES] }
+    }
+}
+
+/// Immutable layout of the node grid over a world.
+#[derive(Clone, Copy, Debug)]
+pub struct SoilLayout {
+    /// Node spacing [m].
+    pub delta: f64,
+    /// Nodes run from index -half to +half on each axis.
+    pub half: i64,
+    /// Chunks per side.
+    pub chunks: usize,
+}
+
+impl SoilLayout {
+    pub fn new(half_extent: f64, delta: f64) -> SoilLayout {
+        let half = (half_extent / delta).ceil() as i64;
+        let nodes = (2 * half + 1) as usize;
+        SoilLayout { delta, half, chunks: nodes.div_ceil(CHUNK) }
+    }
+
+    /// (chunk index, index inside the chunk) of node (i, j), or None off the grid.
+    #[inline]
+    pub fn locate(&self, i: i64, j: i64) -> Option<(usize, usize)> {
+        let (a, b) = (i + self.half, j + self.half);
+        let n = (2 * self.half + 1) as i64;
+        if a < 0 || b < 0 || a >= n || b >= n {
+            return None;
+        }
+        let (a, b) = (a as usize, b as usize);
+        Some(((b / CHUNK) * self.chunks + a / CHUNK, (b % CHUNK) * CHUNK + a % CHUNK))
+    }
+}
+
+/// The mutable soil deformation: cheap to clone (one `Arc`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SoilState {
+    table: Arc<Vec<Option<Arc<Chunk>>>>,
+}
+
+impl SoilState {
+    pub fn new(layout: Option<&SoilLayout>) -> SoilState {
+        let n = layout.map_or(0, |l| l.chunks * l.chunks);
+        SoilState { table: Arc::new(vec![None; n]) }
+    }
+
+    /// (plastic sinkage, yield pressure) of a node; untouched nodes read zero.
+    #[inline]
+    pub fn node(&self, at: (usize, usize)) -> (f64, f64) {
+        match &self.table[at.0] {
+            Some(c) => (f64::from(c.plastic[at.1]), f64::from(c.yield_pressure[at.1])),
+            None => (0.0, 0.0),
+        }
+    }
+
+    /// Writes a node, copying the table and the chunk first if another state shares them.
+    #[inline]
+    pub fn set_node(&mut self, at: (usize, usize), plastic: f64, yield_pressure: f64) {
+        let table = Arc::make_mut(&mut self.table);
+        let chunk = Arc::make_mut(table[at.0].get_or_insert_with(|| Arc::new(Chunk::default())));
+        chunk.plastic[at.1] = plastic as f32;
+        chunk.yield_pressure[at.1] = yield_pressure as f32;
+    }
+
+    /// Number of chunks that hold deformation.
+    pub fn touched_chunks(&self) -> usize {
+        self.table.iter().filter(|c| c.is_some()).count()
+    }
+
+    /// Number of nodes with non-zero plastic sinkage.
+    pub fn deformed_nodes(&self) -> usize {
+        self.table.iter().flatten().map(|c| c.plastic.iter().filter(|p| **p != 0.0).count()).sum()
+    }
+
+    /// Largest plastic sinkage anywhere [m].
+    pub fn max_plastic_sinkage(&self) -> f64 {
+        self.table
+            .iter()
+            .flatten()
+            .flat_map(|c| c.plastic.iter())
+            .fold(0.0f64, |m, p| m.max(f64::from(*p)))
+    }
+
+    /// True when the two states share the same storage (a clone not yet written to).
+    pub fn shares_storage_with(&self, other: &SoilState) -> bool {
+        Arc::ptr_eq(&self.table, &other.table)
+    }
+}
+
+/// Bekker pressure for sinkage `z` [Pa] with patch size `b` [m].
+#[inline]
+pub fn bekker_pressure(soil: &verti_world::SoilParams, b: f64, z: f64) -> f64 {
+    (soil.bekker_kc / b + soil.bekker_kphi) * z.max(0.0).powf(soil.bekker_n)
+}
+
+/// Derivative of the Bekker pressure with respect to sinkage [Pa/m].
+#[inline]
+pub fn bekker_slope(soil: &verti_world::SoilParams, b: f64, z: f64) -> f64 {
+    let z = z.max(1e-4);
+    (soil.bekker_kc / b + soil.bekker_kphi) * soil.bekker_n * z.powf(soil.bekker_n - 1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clone_shares_until_written() {
+        let layout = SoilLayout::new(10.0, 0.1);
+        let mut a = SoilState::new(Some(&layout));
+        let at = layout.locate(3, -4).unwrap();
+        a.set_node(at, 0.05, 1000.0);
+        let mut b = a.clone();
+        assert!(a.shares_storage_with(&b));
+        b.set_node(at, 0.07, 2000.0);
+        assert!(!a.shares_storage_with(&b));
+        assert_eq!(a.node(at), (0.05f32 as f64, 1000.0));
+        assert_eq!(b.node(at), (0.07f32 as f64, 2000.0));
+        assert_eq!(a.touched_chunks(), 1);
+        assert!(layout.locate(1000, 0).is_none());
+    }
+}

@@ -1,0 +1,452 @@
+//! The immutable description of a vehicle ([`VehicleSpec`]), read from YAML.
+//!
+//! Frames: the chassis *reference frame* is ISO (x forward, y left, z up). Its origin is on the
+//! centre line, at wheel-centre height, at the front axle for the HMMWV-style files (any choice
+//! works: every position in the file is relative to it). Suspension travel is along the chassis
+//! z axis; `s` is the spring compression measured from the spring's free length.
+
+use crate::error::SpecError;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Most wheels (or road wheels) a vehicle may have; keeps per-step work bounded.
+pub const MAX_WHEELS: usize = 16;
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VehicleSpec {
+    /// Short identifier, e.g. `hmmwv`.
+    pub name: String,
+    /// One line for humans.
+    pub description: String,
+    /// World scale the vehicle is built for (1 = full scale, 1/6, 1/10).
+    pub scale: f64,
+    /// Fixed internal integration step in seconds. Every shipped vehicle is stable at its value
+    /// (see `tests/validation.rs`); user vehicles choose their own.
+    pub internal_step: f64,
+    pub chassis: ChassisSpec,
+    /// Axles from front to rear. Each carries a left and a right wheel.
+    pub axles: Vec<AxleSpec>,
+    pub tyre: TyreSpec,
+    pub steering: SteeringSpec,
+    pub powertrain: PowertrainSpec,
+    /// Present for tracked vehicles: the wheels of each side are road wheels linked by a track.
+    #[serde(default)]
+    pub track: Option<TrackSpec>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChassisSpec {
+    /// Sprung mass [kg] (everything but the unsprung wheel assemblies).
+    pub mass: f64,
+    /// Principal moments of inertia about the centre of mass, body axes [kg m²].
+    pub inertia: [f64; 3],
+    /// Centre of mass in the reference frame [m].
+    pub com: [f64; 3],
+    /// Collision box (centre and full size, reference frame) used for body contacts.
+    pub collision_box: BoxSpec,
+    /// Coulomb friction of the body against terrain and obstacles.
+    pub friction: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    pub center: [f64; 3],
+    pub size: [f64; 3],
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxleSpec {
+    /// Longitudinal position of the wheel centres [m].
+    pub x: f64,
+    /// Distance between the left and right wheel centres [m].
+    pub track: f64,
+    /// Height of the wheel centres when the spring is at its free length [m].
+    pub z: f64,
+    #[serde(default)]
+    pub steered: bool,
+    #[serde(default)]
+    pub driven: bool,
+    /// Maximum brake torque per wheel [N m].
+    pub brake_torque: f64,
+    pub suspension: SuspensionSpec,
+    pub wheel: WheelSpec,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SuspensionSpec {
+    /// Linear spring rate at the wheel [N/m].
+    pub stiffness: f64,
+    /// Linear damping at the wheel [N s/m].
+    pub damping: f64,
+    /// Compression from free length at which the bump stop engages [m].
+    pub bump_travel: f64,
+    /// Extension beyond free length at which the rebound stop engages [m].
+    pub rebound_travel: f64,
+    /// Stiffness of both stops [N/m] (they also carry the damping of a stiff rubber stop).
+    pub stop_stiffness: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WheelSpec {
+    /// Unloaded tyre radius [m].
+    pub radius: f64,
+    /// Tyre width [m].
+    pub width: f64,
+    /// Rim radius [m]: below it the tyre is bottomed out and contact gets much stiffer.
+    pub rim_radius: f64,
+    /// Mass that moves with the suspension (wheel, tyre, upright, spindle) [kg].
+    pub unsprung_mass: f64,
+    /// Spin inertia of wheel and tyre [kg m²].
+    pub spin_inertia: f64,
+}
+
+/// Tyre force model: radial spring-damper plus a TMeasy-style combined-slip curve. Force values
+/// are per unit normal load at the tyre's own friction `friction`; on ground of lower friction
+/// the peak and sliding values scale down with the patch friction (Chrono combines by `min`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TyreSpec {
+    /// Radial stiffness [N/m].
+    pub radial_stiffness: f64,
+    /// Radial damping [N s/m].
+    pub radial_damping: f64,
+    /// Friction coefficient of the tyre material.
+    pub friction: f64,
+    /// Rolling resistance coefficient (torque = c_rr · Fz · R).
+    pub rolling_resistance: f64,
+    /// Relaxation length of the transient slip [m] (about the radius).
+    pub relaxation_length: f64,
+    /// Longitudinal curve: initial slope, peak (value, slip), sliding (value, slip).
+    pub dfx0: f64,
+    pub fxm: f64,
+    pub sxm: f64,
+    pub fxs: f64,
+    pub sxs: f64,
+    /// Lateral curve (slip = tan of the slip angle).
+    pub dfy0: f64,
+    pub fym: f64,
+    pub sym: f64,
+    pub fys: f64,
+    pub sys: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SteeringKind {
+    /// Steered wheels turn with Ackermann geometry about the rear (unsteered) axles.
+    Ackermann,
+    /// Skid (differential) steering: the steering input biases drive torque between the sides
+    /// and brakes the inner side (tracked vehicles).
+    Skid,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SteeringSpec {
+    pub kind: SteeringKind,
+    /// Ackermann: bicycle-model (centre) road-wheel angle at full input [deg].
+    #[serde(default)]
+    pub max_angle_deg: f64,
+    /// Ackermann: slew-rate limit of the centre angle [deg/s].
+    #[serde(default)]
+    pub rate_deg_per_s: f64,
+    /// Skid: brake torque on the inner side at full input, per wheel [N m].
+    #[serde(default)]
+    pub skid_brake_torque: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Differential {
+    /// Both outputs turn at the same speed (wheels share one spin degree of freedom).
+    Locked,
+    /// Equal torque to both outputs; speeds are free.
+    Open,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PowertrainSpec {
+    /// Engine or motor speed cap [rpm]; the maps are clamped to [0, max].
+    pub max_speed_rpm: f64,
+    /// Full-throttle torque map: (speed rad/s, torque N m), increasing speed.
+    pub full_throttle: Vec<[f64; 2]>,
+    /// Closed-throttle (engine braking) map, same form.
+    pub zero_throttle: Vec<[f64; 2]>,
+    /// Forward gear ratios (output speed / engine speed), increasing.
+    pub gears: Vec<f64>,
+    /// Upshift above this engine speed [rpm] (ignored with one gear).
+    pub upshift_rpm: f64,
+    /// Downshift below this engine speed [rpm].
+    pub downshift_rpm: f64,
+    /// Final drive ratio (wheel speed / driveshaft speed).
+    pub final_drive: f64,
+    pub axle_differential: Differential,
+    pub central_differential: Differential,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackSpec {
+    /// Mass of one track (all shoes) [kg]; counted as sprung mass and as spin inertia of its side.
+    pub track_mass: f64,
+}
+
+impl VehicleSpec {
+    /// Parses and validates a vehicle from YAML text. `origin` names the source in errors.
+    pub fn from_yaml_str(text: &str, origin: &str) -> Result<VehicleSpec, SpecError> {
+        let spec: VehicleSpec = serde_norway::from_str(text).map_err(|e| SpecError::Parse {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
+        spec.validate(origin)?;
+        Ok(spec)
+    }
+
+    /// Reads a user vehicle file.
+    pub fn from_file(path: impl AsRef<Path>) -> Result<VehicleSpec, SpecError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| SpecError::Io { path: path.to_path_buf(), source })?;
+        Self::from_yaml_str(&text, &path.display().to_string())
+    }
+
+    /// YAML text of this vehicle (round-trips through [`VehicleSpec::from_yaml_str`]).
+    pub fn to_yaml(&self) -> String {
+        serde_norway::to_string(self).unwrap_or_default()
+    }
+
+    /// Number of wheels (two per axle).
+    pub fn wheel_count(&self) -> usize {
+        2 * self.axles.len()
+    }
+
+    pub fn is_tracked(&self) -> bool {
+        self.track.is_some()
+    }
+
+    /// Total mass: sprung + unsprung (+ tracks, which are part of the sprung mass).
+    pub fn total_mass(&self) -> f64 {
+        self.chassis.mass + self.axles.iter().map(|a| 2.0 * a.wheel.unsprung_mass).sum::<f64>()
+    }
+
+    /// Distance from the first to the last axle.
+    pub fn wheelbase(&self) -> f64 {
+        let first = self.axles.first().map_or(0.0, |a| a.x);
+        let last = self.axles.last().map_or(0.0, |a| a.x);
+        first - last
+    }
+
+    /// Checks every field; the error names the first bad field.
+    pub fn validate(&self, origin: &str) -> Result<(), SpecError> {
+        let bad = |field: String, problem: String| SpecError::Invalid { origin: origin.to_string(), field, problem };
+        let pos = |field: &str, v: f64| -> Result<(), SpecError> {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(bad(field.to_string(), format!("{v} must be a positive finite number")))
+            }
+        };
+        let nonneg = |field: &str, v: f64| -> Result<(), SpecError> {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(bad(field.to_string(), format!("{v} must be a finite number >= 0")))
+            }
+        };
+        let finite = |field: &str, v: f64| -> Result<(), SpecError> {
+            if v.is_finite() { Ok(()) } else { Err(bad(field.to_string(), format!("{v} must be finite"))) }
+        };
+        if self.name.trim().is_empty() {
+            return Err(bad("name".into(), "must not be empty".into()));
+        }
+        pos("scale", self.scale)?;
+        pos("internal_step", self.internal_step)?;
+        if self.internal_step > 0.01 {
+            return Err(bad("internal_step".into(), format!("{} s is too coarse (max 0.01 s)", self.internal_step)));
+        }
+        let c = &self.chassis;
+        pos("chassis.mass", c.mass)?;
+        for (i, v) in c.inertia.iter().enumerate() {
+            pos(&format!("chassis.inertia[{i}]"), *v)?;
+        }
+        let [a, b, cc] = c.inertia;
+        if a + b < cc || a + cc < b || b + cc < a {
+            return Err(bad("chassis.inertia".into(), "violates the triangle inequality of a rigid body".into()));
+        }
+        for (i, v) in c.com.iter().enumerate() {
+            finite(&format!("chassis.com[{i}]"), *v)?;
+        }
+        for i in 0..3 {
+            finite(&format!("chassis.collision_box.center[{i}]"), c.collision_box.center[i])?;
+            pos(&format!("chassis.collision_box.size[{i}]"), c.collision_box.size[i])?;
+        }
+        nonneg("chassis.friction", c.friction)?;
+        if self.axles.is_empty() {
+            return Err(bad("axles".into(), "a vehicle needs at least one axle".into()));
+        }
+        if self.wheel_count() > MAX_WHEELS {
+            return Err(bad("axles".into(), format!("{} wheels; at most {MAX_WHEELS} are supported", self.wheel_count())));
+        }
+        for (i, ax) in self.axles.iter().enumerate() {
+            let f = |name: &str| format!("axles[{i}].{name}");
+            finite(&f("x"), ax.x)?;
+            finite(&f("z"), ax.z)?;
+            pos(&f("track"), ax.track)?;
+            nonneg(&f("brake_torque"), ax.brake_torque)?;
+            let s = &ax.suspension;
+            pos(&f("suspension.stiffness"), s.stiffness)?;
+            nonneg(&f("suspension.damping"), s.damping)?;
+            pos(&f("suspension.bump_travel"), s.bump_travel)?;
+            nonneg(&f("suspension.rebound_travel"), s.rebound_travel)?;
+            pos(&f("suspension.stop_stiffness"), s.stop_stiffness)?;
+            let w = &ax.wheel;
+            pos(&f("wheel.radius"), w.radius)?;
+            pos(&f("wheel.width"), w.width)?;
+            pos(&f("wheel.rim_radius"), w.rim_radius)?;
+            if w.rim_radius >= w.radius {
+                return Err(bad(f("wheel.rim_radius"), format!("{} must be smaller than the radius {}", w.rim_radius, w.radius)));
+            }
+            pos(&f("wheel.unsprung_mass"), w.unsprung_mass)?;
+            pos(&f("wheel.spin_inertia"), w.spin_inertia)?;
+            if i > 0 && ax.x >= self.axles[i - 1].x {
+                return Err(bad(f("x"), "axles must be listed from front to rear (decreasing x)".into()));
+            }
+        }
+        if !self.axles.iter().any(|a| a.driven) {
+            return Err(bad("axles".into(), "no axle is driven".into()));
+        }
+        let t = &self.tyre;
+        pos("tyre.radial_stiffness", t.radial_stiffness)?;
+        nonneg("tyre.radial_damping", t.radial_damping)?;
+        pos("tyre.friction", t.friction)?;
+        nonneg("tyre.rolling_resistance", t.rolling_resistance)?;
+        pos("tyre.relaxation_length", t.relaxation_length)?;
+        for (name, df0, fm, sm, fs, ss) in [
+            ("x", t.dfx0, t.fxm, t.sxm, t.fxs, t.sxs),
+            ("y", t.dfy0, t.fym, t.sym, t.fys, t.sys),
+        ] {
+            pos(&format!("tyre.df{name}0"), df0)?;
+            pos(&format!("tyre.f{name}m"), fm)?;
+            pos(&format!("tyre.s{name}m"), sm)?;
+            pos(&format!("tyre.f{name}s"), fs)?;
+            pos(&format!("tyre.s{name}s"), ss)?;
+            if df0 * sm <= fm {
+                return Err(bad(format!("tyre.df{name}0"), format!("initial slope {df0} must exceed f{name}m / s{name}m = {}", fm / sm)));
+            }
+            if ss <= sm || fs > fm {
+                return Err(bad(format!("tyre.s{name}s"), "sliding slip must exceed the peak slip and sliding force must not exceed the peak".into()));
+            }
+        }
+        let st = &self.steering;
+        match st.kind {
+            SteeringKind::Ackermann => {
+                if !(st.max_angle_deg.is_finite() && st.max_angle_deg > 0.0 && st.max_angle_deg < 80.0) {
+                    return Err(bad("steering.max_angle_deg".into(), format!("{} must be in (0, 80)", st.max_angle_deg)));
+                }
+                pos("steering.rate_deg_per_s", st.rate_deg_per_s)?;
+                if !self.axles.iter().any(|a| a.steered) {
+                    return Err(bad("axles".into(), "Ackermann steering needs a steered axle".into()));
+                }
+                if self.axles.iter().all(|a| a.steered) {
+                    return Err(bad("axles".into(), "Ackermann steering needs at least one unsteered axle".into()));
+                }
+            }
+            SteeringKind::Skid => {
+                nonneg("steering.skid_brake_torque", st.skid_brake_torque)?;
+                if self.axles.iter().any(|a| a.steered) {
+                    return Err(bad("axles".into(), "skid-steered vehicles have no steered axles".into()));
+                }
+            }
+        }
+        let p = &self.powertrain;
+        pos("powertrain.max_speed_rpm", p.max_speed_rpm)?;
+        for (name, map) in [("full_throttle", &p.full_throttle), ("zero_throttle", &p.zero_throttle)] {
+            if map.len() < 2 {
+                return Err(bad(format!("powertrain.{name}"), "a map needs at least two points".into()));
+            }
+            for (k, pt) in map.iter().enumerate() {
+                finite(&format!("powertrain.{name}[{k}][0]"), pt[0])?;
+                finite(&format!("powertrain.{name}[{k}][1]"), pt[1])?;
+                if k > 0 && pt[0] <= map[k - 1][0] {
+                    return Err(bad(format!("powertrain.{name}[{k}]"), "speeds must increase".into()));
+                }
+            }
+        }
+        if p.gears.is_empty() {
+            return Err(bad("powertrain.gears".into(), "needs at least one gear".into()));
+        }
+        for (k, g) in p.gears.iter().enumerate() {
+            pos(&format!("powertrain.gears[{k}]"), *g)?;
+            if k > 0 && *g <= p.gears[k - 1] {
+                return Err(bad(format!("powertrain.gears[{k}]"), "gear ratios must increase".into()));
+            }
+        }
+        pos("powertrain.upshift_rpm", p.upshift_rpm)?;
+        nonneg("powertrain.downshift_rpm", p.downshift_rpm)?;
+        if p.gears.len() > 1 && p.downshift_rpm * p.gears[1] / p.gears[0] >= p.upshift_rpm {
+            return Err(bad("powertrain.downshift_rpm".into(), "shift bands overlap: an upshift would immediately downshift".into()));
+        }
+        pos("powertrain.final_drive", p.final_drive)?;
+        if let Some(tr) = &self.track {
+            nonneg("track.track_mass", tr.track_mass)?;
+            if st.kind != SteeringKind::Skid {
+                return Err(bad("steering.kind".into(), "a tracked vehicle must use skid steering".into()));
+            }
+        }
+        Ok(())
+    }
+
+    /// A human-readable description for `verti vehicle show NAME`.
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(s, "{} — {}", self.name, self.description);
+        let _ = writeln!(s, "  scale            {}", verti_world::scale::scale_label(self.scale));
+        let _ = writeln!(
+            s,
+            "  mass             {:.2} kg total ({:.2} kg sprung), inertia {:?} kg m²",
+            self.total_mass(),
+            self.chassis.mass,
+            self.chassis.inertia
+        );
+        let _ = writeln!(s, "  wheelbase        {:.3} m, {} axles, {} wheels{}", self.wheelbase(), self.axles.len(), self.wheel_count(), if self.is_tracked() { " (road wheels on tracks)" } else { "" });
+        for (i, a) in self.axles.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "  axle {i}: x {:+.3} m, track {:.3} m, tyre r {:.3} w {:.3} m, spring {:.0} N/m, damper {:.0} N s/m{}{}",
+                a.x,
+                a.track,
+                a.wheel.radius,
+                a.wheel.width,
+                a.suspension.stiffness,
+                a.suspension.damping,
+                if a.steered { ", steered" } else { "" },
+                if a.driven { ", driven" } else { "" }
+            );
+        }
+        match self.steering.kind {
+            SteeringKind::Ackermann => {
+                let _ = writeln!(s, "  steering         Ackermann, max {:.1}°, {:.0}°/s", self.steering.max_angle_deg, self.steering.rate_deg_per_s);
+            }
+            SteeringKind::Skid => {
+                let _ = writeln!(s, "  steering         skid, inner-side brake {:.0} N m per wheel", self.steering.skid_brake_torque);
+            }
+        }
+        let p = &self.powertrain;
+        let peak = p.full_throttle.iter().map(|pt| pt[1]).fold(f64::NEG_INFINITY, f64::max);
+        let _ = writeln!(
+            s,
+            "  powertrain       peak {:.1} N m, max {:.0} rpm, gears {:?}, final drive {}, differentials axle {:?} / central {:?}",
+            peak, p.max_speed_rpm, p.gears, p.final_drive, p.axle_differential, p.central_differential
+        );
+        let _ = writeln!(s, "  tyre             μ {}, Cz {:.3e} N/m, rolling resistance {}", self.tyre.friction, self.tyre.radial_stiffness, self.tyre.rolling_resistance);
+        let _ = write!(s, "  internal step    {} ms", self.internal_step * 1e3);
+        s
+    }
+}

@@ -1,0 +1,134 @@
+//! Precomputed, immutable acceleration structures over a world, built once per [`crate::Sim`]:
+//! a coarse grid of maximum heights (so contact samples far above the ground are skipped
+//! without touching the heightfield) and a broad-phase grid of obstacle indices.
+
+use verti_world::World;
+
+/// Heightfield cells per side of one bound block.
+const BLOCK_CELLS: usize = 4;
+
+/// Maximum terrain height per block of 4x4 heightfield cells.
+#[derive(Clone, Debug)]
+pub struct HeightBound {
+    blocks: usize,
+    /// World size of one block [m].
+    block_size: f64,
+    half_extent: f64,
+    max: Vec<f64>,
+}
+
+impl HeightBound {
+    pub fn new(world: &World) -> HeightBound {
+        let hf = &world.terrain;
+        let n = hf.size();
+        let blocks = (n - 1).div_ceil(BLOCK_CELLS);
+        let mut max = vec![f64::NEG_INFINITY; blocks * blocks];
+        for br in 0..blocks {
+            for bc in 0..blocks {
+                let mut m = f64::NEG_INFINITY;
+                for r in br * BLOCK_CELLS..=((br + 1) * BLOCK_CELLS).min(n - 1) {
+                    for c in bc * BLOCK_CELLS..=((bc + 1) * BLOCK_CELLS).min(n - 1) {
+                        m = m.max(hf.vertex(r, c));
+                    }
+                }
+                max[br * blocks + bc] = m;
+            }
+        }
+        HeightBound { blocks, block_size: BLOCK_CELLS as f64 * hf.cell(), half_extent: hf.half_extent(), max }
+    }
+
+    /// Block (row, col) of a world point, clamped to the map (off-map points read the edge,
+    /// like the heightfield itself).
+    #[inline]
+    fn block_of(&self, x: f64, y: f64) -> (usize, usize) {
+        let m = (self.blocks - 1) as f64;
+        let col = ((x + self.half_extent) / self.block_size).floor().clamp(0.0, m) as usize;
+        let row = ((self.half_extent - y) / self.block_size).floor().clamp(0.0, m) as usize;
+        (row, col)
+    }
+
+    /// An upper bound of the terrain height at (x, y).
+    #[inline]
+    pub fn max_at(&self, x: f64, y: f64) -> f64 {
+        let (r, c) = self.block_of(x, y);
+        self.max[r * self.blocks + c]
+    }
+
+    /// An upper bound of the terrain height over the box [x0, x1] x [y0, y1].
+    pub fn max_in(&self, x0: f64, y0: f64, x1: f64, y1: f64) -> f64 {
+        let (r0, c0) = self.block_of(x0, y1);
+        let (r1, c1) = self.block_of(x1, y0);
+        let mut m = f64::NEG_INFINITY;
+        for r in r0..=r1 {
+            for c in c0..=c1 {
+                m = m.max(self.max[r * self.blocks + c]);
+            }
+        }
+        m
+    }
+}
+
+/// A uniform grid over the map listing, per cell, the obstacles whose footprint circle,
+/// grown by the vehicle's bounding radius, overlaps the cell. One lookup at the vehicle's
+/// centre of mass then gives every obstacle any part of the vehicle could touch.
+#[derive(Clone, Debug)]
+pub struct ObstacleGrid {
+    cells: usize,
+    cell: f64,
+    origin: f64,
+    /// Start offsets into `items` per cell (`cells² + 1` entries, CSR layout).
+    starts: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl ObstacleGrid {
+    /// `reach`: the vehicle's bounding radius around its centre of mass (plus a margin).
+    pub fn new(world: &World, reach: f64) -> ObstacleGrid {
+        let extent = world.terrain.half_extent() + reach;
+        let cell = (2.0 * reach).max(world.terrain.cell() * 2.0);
+        let cells = ((2.0 * extent / cell).ceil() as usize).clamp(1, 512);
+        let cell = 2.0 * extent / cells as f64;
+        let origin = -extent;
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); cells * cells];
+        for (k, o) in world.obstacles.iter().enumerate() {
+            let p = o.position();
+            let r = o.radius_xy() + reach;
+            let lo_c = (((p.x - r) - origin) / cell).floor().max(0.0) as usize;
+            let hi_c = ((((p.x + r) - origin) / cell).floor().max(0.0) as usize).min(cells - 1);
+            let lo_r = (((p.y - r) - origin) / cell).floor().max(0.0) as usize;
+            let hi_r = ((((p.y + r) - origin) / cell).floor().max(0.0) as usize).min(cells - 1);
+            if lo_c > hi_c || lo_r > hi_r {
+                continue;
+            }
+            for row in lo_r..=hi_r {
+                for col in lo_c..=hi_c {
+                    lists[row * cells + col].push(k as u32);
+                }
+            }
+        }
+        let mut starts = Vec::with_capacity(cells * cells + 1);
+        let mut items = Vec::new();
+        for l in &lists {
+            starts.push(items.len() as u32);
+            items.extend_from_slice(l);
+        }
+        starts.push(items.len() as u32);
+        ObstacleGrid { cells, cell, origin, starts, items }
+    }
+
+    /// Indices of the obstacles near (x, y); empty off the grid.
+    #[inline]
+    pub fn near(&self, x: f64, y: f64) -> &[u32] {
+        let c = (x - self.origin) / self.cell;
+        let r = (y - self.origin) / self.cell;
+        if !(c >= 0.0 && r >= 0.0) {
+            return &[];
+        }
+        let (c, r) = (c as usize, r as usize);
+        if c >= self.cells || r >= self.cells {
+            return &[];
+        }
+        let k = r * self.cells + c;
+        &self.items[self.starts[k] as usize..self.starts[k + 1] as usize]
+    }
+}
