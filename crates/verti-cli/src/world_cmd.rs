@@ -100,8 +100,17 @@ pub fn run(cmd: WorldCommand) -> CmdResult {
 
 /// Refuses to write into a non-empty directory unless forced, so a typo never clobbers data.
 fn check_out_dir(out: &Path, force: bool) -> Result<(), WorldError> {
-    if out.exists() && !force && out.read_dir().map(|mut d| d.next().is_some()).unwrap_or(true) {
-        return Err(WorldError::Argument(format!("{} exists and is not empty (use --force to overwrite)", out.display())));
+    if out.exists()
+        && !force
+        && out
+            .read_dir()
+            .map(|mut d| d.next().is_some())
+            .unwrap_or(true)
+    {
+        return Err(WorldError::Argument(format!(
+            "{} exists and is not empty (use --force to overwrite)",
+            out.display()
+        )));
     }
     if force && out.exists() {
         std::fs::remove_dir_all(out).map_err(|e| WorldError::io(out, e))?;
@@ -110,7 +119,12 @@ fn check_out_dir(out: &Path, force: bool) -> Result<(), WorldError> {
 }
 
 fn generate(a: GenerateArgs) -> CmdResult {
-    let config = SetConfig { seed: a.seed, count: a.count, scale: a.scale.scale, clearance: a.clearance };
+    let config = SetConfig {
+        seed: a.seed,
+        count: a.count,
+        scale: a.scale.scale,
+        clearance: a.clearance,
+    };
     config.validate()?;
     let name = set_name(&config);
     let out = a.out.unwrap_or_else(|| PathBuf::from("worlds").join(&name));
@@ -148,11 +162,19 @@ fn count_by<K: Ord + std::fmt::Display>(worlds: &[World], key: impl Fn(&World) -
     for w in worlds {
         *counts.entry(key(w)).or_insert(0usize) += 1;
     }
-    counts.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ")
+    counts
+        .iter()
+        .map(|(k, v)| format!("{k} {v}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn import(a: ImportArgs) -> CmdResult {
-    let opts = ImportOptions { scale: a.scale.scale, clearance: a.clearance, index: None };
+    let opts = ImportOptions {
+        scale: a.scale.scale,
+        clearance: a.clearance,
+        index: None,
+    };
     check_out_dir(&a.out, a.force)?;
     if let Some(dir) = a.dir {
         let files = scan_vb_dir(&dir)?;
@@ -169,14 +191,25 @@ fn import(a: ImportArgs) -> CmdResult {
                 .collect::<Result<Vec<_>, _>>()?
         };
         pb.finish_and_clear();
-        let name = format!("vb-{}", dir.file_name().and_then(|n| n.to_str()).unwrap_or("import"));
+        let name = format!(
+            "vb-{}",
+            dir.file_name().and_then(|n| n.to_str()).unwrap_or("import")
+        );
         save_set(&worlds, &name, None, &a.out, &|| {})?;
-        println!("imported {} Verti-Bench worlds into {}", worlds.len(), a.out.display());
+        println!(
+            "imported {} Verti-Bench worlds into {}",
+            worlds.len(),
+            a.out.display()
+        );
         print_composition(&worlds);
         return Ok(());
     }
-    let config = a.config.ok_or_else(|| WorldError::Argument("give a CONFIG.yaml with --heightmap, or --dir FOLDER".into()))?;
-    let heightmap = a.heightmap.ok_or_else(|| WorldError::Argument("--heightmap WORLD.bmp is required with a config".into()))?;
+    let config = a.config.ok_or_else(|| {
+        WorldError::Argument("give a CONFIG.yaml with --heightmap, or --dir FOLDER".into())
+    })?;
+    let heightmap = a.heightmap.ok_or_else(|| {
+        WorldError::Argument("--heightmap WORLD.bmp is required with a config".into())
+    })?;
     let w = import_vb(&config, &heightmap, a.labels.as_deref(), &opts)?;
     save_world(&w, &a.out)?;
     println!("imported {} into {}", w.meta.name, a.out.display());
@@ -209,7 +242,11 @@ pub fn describe(w: &World) -> String {
         w.terrain.min_height(),
         w.terrain.max_height(),
         w.meta.max_height,
-        classes.iter().map(|(c, n)| format!("{c} {n}")).collect::<Vec<_>>().join(", "),
+        classes
+            .iter()
+            .map(|(c, n)| format!("{c} {n}"))
+            .collect::<Vec<_>>()
+            .join(", "),
         rocks,
         w.obstacles.len() - rocks,
         w.tasks.len()
@@ -223,14 +260,21 @@ pub fn describe(w: &World) -> String {
             t.goal[0],
             t.goal[1],
             p.length(),
-            if p.points.is_empty() { " (no path)" } else { "" }
+            if p.points.is_empty() {
+                " (no path)"
+            } else {
+                ""
+            }
         ));
     }
     s
 }
 
 /// Resolves a set for commands that take one, with a progress bar.
-pub fn load_set_with_progress(spec: &str, scale: f64) -> Result<verti_world::sets::WorldSet, WorldError> {
+pub fn load_set_with_progress(
+    spec: &str,
+    scale: f64,
+) -> Result<verti_world::sets::WorldSet, WorldError> {
     let pb = bar(0, "loading");
     let set = resolve_set(spec, scale, &|| pb.inc(1));
     pb.finish_and_clear();

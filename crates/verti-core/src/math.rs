@@ -15,10 +15,26 @@ pub struct Vec3 {
 }
 
 impl Vec3 {
-    pub const ZERO: Vec3 = Vec3 { x: 0.0, y: 0.0, z: 0.0 };
-    pub const X: Vec3 = Vec3 { x: 1.0, y: 0.0, z: 0.0 };
-    pub const Y: Vec3 = Vec3 { x: 0.0, y: 1.0, z: 0.0 };
-    pub const Z: Vec3 = Vec3 { x: 0.0, y: 0.0, z: 1.0 };
+    pub const ZERO: Vec3 = Vec3 {
+        x: 0.0,
+        y: 0.0,
+        z: 0.0,
+    };
+    pub const X: Vec3 = Vec3 {
+        x: 1.0,
+        y: 0.0,
+        z: 0.0,
+    };
+    pub const Y: Vec3 = Vec3 {
+        x: 0.0,
+        y: 1.0,
+        z: 0.0,
+    };
+    pub const Z: Vec3 = Vec3 {
+        x: 0.0,
+        y: 0.0,
+        z: 1.0,
+    };
 
     #[inline]
     pub const fn new(x: f64, y: f64, z: f64) -> Self {
@@ -182,15 +198,31 @@ impl Mat3 {
     }
     #[inline]
     pub fn mul_vec(&self, v: Vec3) -> Vec3 {
-        Vec3::new(self.rows[0].dot(v), self.rows[1].dot(v), self.rows[2].dot(v))
+        Vec3::new(
+            self.rows[0].dot(v),
+            self.rows[1].dot(v),
+            self.rows[2].dot(v),
+        )
     }
     #[inline]
     pub fn mul_mat(&self, o: &Mat3) -> Mat3 {
         let t = o.transpose();
         Mat3::from_rows(
-            Vec3::new(self.rows[0].dot(t.rows[0]), self.rows[0].dot(t.rows[1]), self.rows[0].dot(t.rows[2])),
-            Vec3::new(self.rows[1].dot(t.rows[0]), self.rows[1].dot(t.rows[1]), self.rows[1].dot(t.rows[2])),
-            Vec3::new(self.rows[2].dot(t.rows[0]), self.rows[2].dot(t.rows[1]), self.rows[2].dot(t.rows[2])),
+            Vec3::new(
+                self.rows[0].dot(t.rows[0]),
+                self.rows[0].dot(t.rows[1]),
+                self.rows[0].dot(t.rows[2]),
+            ),
+            Vec3::new(
+                self.rows[1].dot(t.rows[0]),
+                self.rows[1].dot(t.rows[1]),
+                self.rows[1].dot(t.rows[2]),
+            ),
+            Vec3::new(
+                self.rows[2].dot(t.rows[0]),
+                self.rows[2].dot(t.rows[1]),
+                self.rows[2].dot(t.rows[2]),
+            ),
         )
     }
 }
@@ -211,13 +243,23 @@ impl Default for Quat {
 }
 
 impl Quat {
-    pub const IDENTITY: Quat = Quat { w: 1.0, x: 0.0, y: 0.0, z: 0.0 };
+    pub const IDENTITY: Quat = Quat {
+        w: 1.0,
+        x: 0.0,
+        y: 0.0,
+        z: 0.0,
+    };
 
     #[inline]
     pub fn from_axis_angle(axis: Vec3, angle: f64) -> Quat {
         let a = axis.normalized();
         let (s, c) = (0.5 * angle).sin_cos();
-        Quat { w: c, x: a.x * s, y: a.y * s, z: a.z * s }
+        Quat {
+            w: c,
+            x: a.x * s,
+            y: a.y * s,
+            z: a.z * s,
+        }
     }
 
     /// Z-Y-X Tait–Bryan angles: R = Rz(yaw)·Ry(pitch)·Rx(roll) (Chrono's "Cardan XYZ").
@@ -250,13 +292,23 @@ impl Quat {
 
     #[inline]
     pub fn conjugate(self) -> Quat {
-        Quat { w: self.w, x: -self.x, y: -self.y, z: -self.z }
+        Quat {
+            w: self.w,
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+        }
     }
 
     #[inline]
     pub fn normalized(self) -> Quat {
         let n = (self.w * self.w + self.x * self.x + self.y * self.y + self.z * self.z).sqrt();
-        Quat { w: self.w / n, x: self.x / n, y: self.y / n, z: self.z / n }
+        Quat {
+            w: self.w / n,
+            x: self.x / n,
+            y: self.y / n,
+            z: self.z / n,
+        }
     }
 
     /// Rotates a body-frame vector into the world frame.
@@ -275,7 +327,11 @@ impl Quat {
 
     /// Rotation matrix (columns are the body axes in world coordinates).
     pub fn to_mat3(self) -> Mat3 {
-        Mat3::from_cols(self.rotate(Vec3::X), self.rotate(Vec3::Y), self.rotate(Vec3::Z))
+        Mat3::from_cols(
+            self.rotate(Vec3::X),
+            self.rotate(Vec3::Y),
+            self.rotate(Vec3::Z),
+        )
     }
 
     /// Integrates an angular velocity given in the world frame over `dt` (exact for constant ω).
@@ -313,7 +369,10 @@ mod tests {
         for &(r, p, y) in &[(0.1, -0.2, 0.3), (-1.0, 0.5, 3.0), (0.0, 0.0, -2.0)] {
             let q = Quat::from_euler(r, p, y);
             let (r2, p2, y2) = q.to_euler();
-            assert!(close(r, r2) && close(p, p2) && close(y, y2), "{r2} {p2} {y2}");
+            assert!(
+                close(r, r2) && close(p, p2) && close(y, y2),
+                "{r2} {p2} {y2}"
+            );
         }
     }
 
@@ -342,7 +401,10 @@ mod tests {
 
     #[test]
     fn wrap() {
-        assert!(close(wrap_angle(3.0 * std::f64::consts::PI), -std::f64::consts::PI));
+        assert!(close(
+            wrap_angle(3.0 * std::f64::consts::PI),
+            -std::f64::consts::PI
+        ));
         assert!(close(wrap_angle(0.5), 0.5));
         assert!(close(wrap_angle(-0.5 - std::f64::consts::TAU), -0.5));
     }

@@ -18,7 +18,7 @@ pub fn splitmix64(state: &mut u64) -> u64 {
 /// Mixes several integers into one 64-bit seed (order-sensitive). Used to derive per-world,
 /// per-task or per-episode seeds from a user seed, so parallel work never shares a stream.
 pub fn mix_seed(parts: &[u64]) -> u64 {
-    let mut state = 0x5EED_0F_7E27_1u64;
+    let mut state = 0x05EE_D0F7_E271_u64;
     let mut out = 0u64;
     for &p in parts {
         state ^= p;

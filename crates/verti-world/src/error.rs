@@ -25,9 +25,16 @@ pub enum WorldError {
 
 impl WorldError {
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
-        WorldError::Io { path: path.into(), source }
+        WorldError::Io {
+            path: path.into(),
+            source,
+        }
     }
-    pub fn invalid(path: impl Into<PathBuf>, field: impl Into<String>, problem: impl Into<String>) -> Self {
+    pub fn invalid(
+        path: impl Into<PathBuf>,
+        field: impl Into<String>,
+        problem: impl Into<String>,
+    ) -> Self {
         WorldError::Invalid {
             path: path.into(),
             field: field.into(),

@@ -17,7 +17,9 @@ use crate::heightfield::Heightfield;
 use crate::npy;
 use crate::obstacle::{Face, Obstacle, ObstacleShape};
 use crate::surface::{PATCHES_PER_SIDE, Patch, PatchGrid, SoilParams, Surface, TerrainClass};
-use crate::world::{ElevationLevel, GlobalPath, ObstacleDensity, Task, TerrainType, World, WorldMeta, WorldSource};
+use crate::world::{
+    ElevationLevel, GlobalPath, ObstacleDensity, Task, TerrainType, World, WorldMeta, WorldSource,
+};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -86,7 +88,11 @@ enum ObstacleSpec {
         /// Bounding planes in the rock frame: [nx, ny, nz, offset] with n·p <= offset inside.
         faces: Vec<[f64; 4]>,
     },
-    Tree { position: [f64; 3], radius: f64, height: f64 },
+    Tree {
+        position: [f64; 3],
+        radius: f64,
+        height: f64,
+    },
 }
 
 #[derive(Serialize, Deserialize)]
@@ -112,7 +118,10 @@ fn soil_name(soil: &SoilParams) -> String {
     } else if *soil == SoilParams::HARD {
         "hard".into()
     } else {
-        format!("custom-{:016x}", soil.bekker_kphi.to_bits() ^ soil.elastic_k.to_bits().rotate_left(7))
+        format!(
+            "custom-{:016x}",
+            soil.bekker_kphi.to_bits() ^ soil.elastic_k.to_bits().rotate_left(7)
+        )
     }
 }
 
@@ -130,11 +139,28 @@ pub fn save_world(world: &World, dir: &Path) -> Result<()> {
     for (k, p) in world.patches.patches().iter().enumerate() {
         let (row, col) = (k / PATCHES_PER_SIDE, k % PATCHES_PER_SIDE);
         patches.push(match p.surface {
-            Surface::Rigid { friction, restitution } => PatchSpec { row, col, class: p.class, friction: Some(friction), restitution: Some(restitution), soil: None },
+            Surface::Rigid {
+                friction,
+                restitution,
+            } => PatchSpec {
+                row,
+                col,
+                class: p.class,
+                friction: Some(friction),
+                restitution: Some(restitution),
+                soil: None,
+            },
             Surface::Deformable { soil } => {
                 let name = soil_name(&soil);
                 soils.insert(name.clone(), soil);
-                PatchSpec { row, col, class: p.class, friction: None, restitution: None, soil: Some(name) }
+                PatchSpec {
+                    row,
+                    col,
+                    class: p.class,
+                    friction: None,
+                    restitution: None,
+                    soil: Some(name),
+                }
             }
         });
     }
@@ -148,9 +174,16 @@ pub fn save_world(world: &World, dir: &Path) -> Result<()> {
                     position: p.to_array(),
                     yaw: o.yaw(),
                     scale: *scale,
-                    faces: faces.iter().map(|f| [f.normal.x, f.normal.y, f.normal.z, f.offset]).collect(),
+                    faces: faces
+                        .iter()
+                        .map(|f| [f.normal.x, f.normal.y, f.normal.z, f.offset])
+                        .collect(),
                 },
-                ObstacleShape::Tree { radius, height } => ObstacleSpec::Tree { position: p.to_array(), radius: *radius, height: *height },
+                ObstacleShape::Tree { radius, height } => ObstacleSpec::Tree {
+                    position: p.to_array(),
+                    radius: *radius,
+                    height: *height,
+                },
             }
         })
         .collect();
@@ -165,50 +198,118 @@ pub fn save_world(world: &World, dir: &Path) -> Result<()> {
         density: world.meta.density,
         scale: world.meta.scale,
         max_height: world.meta.max_height,
-        grid: GridSpec { size: n, cell: world.terrain.cell(), elevation: ELEVATION.into(), labels: LABELS.into() },
+        grid: GridSpec {
+            size: n,
+            cell: world.terrain.cell(),
+            elevation: ELEVATION.into(),
+            labels: LABELS.into(),
+        },
         soils,
         patches,
         obstacles,
         tasks: world.tasks.clone(),
         paths: PathsSpec {
             clearance: world.path_clearance,
-            paths: world.paths.iter().zip(&world.tasks).map(|(p, t)| PathSpec { pair: t.pair, points: p.points.clone() }).collect(),
+            paths: world
+                .paths
+                .iter()
+                .zip(&world.tasks)
+                .map(|(p, t)| PathSpec {
+                    pair: t.pair,
+                    points: p.points.clone(),
+                })
+                .collect(),
         },
     };
-    let text = crate::yaml::to_yaml(&manifest)
-        .map_err(|e| WorldError::invalid(dir.join(MANIFEST), "manifest", format!("cannot serialise: {e}")))?;
+    let text = crate::yaml::to_yaml(&manifest).map_err(|e| {
+        WorldError::invalid(
+            dir.join(MANIFEST),
+            "manifest",
+            format!("cannot serialise: {e}"),
+        )
+    })?;
     let header = "# verti world manifest (format verti-world v1). Heights: elevation.npy; labels: labels.npy.\n";
-    std::fs::write(dir.join(MANIFEST), format!("{header}{text}")).map_err(|e| WorldError::io(dir.join(MANIFEST), e))
+    std::fs::write(dir.join(MANIFEST), format!("{header}{text}"))
+        .map_err(|e| WorldError::io(dir.join(MANIFEST), e))
 }
 
 fn finite(path: &Path, field: &str, v: f64) -> Result<f64> {
-    if v.is_finite() { Ok(v) } else { Err(WorldError::invalid(path, field, format!("{v} is not a finite number"))) }
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(WorldError::invalid(
+            path,
+            field,
+            format!("{v} is not a finite number"),
+        ))
+    }
 }
 
 /// Loads and validates a world directory (or a path to its `world.yaml`).
 pub fn load_world(path: &Path) -> Result<World> {
-    let dir: PathBuf = if path.is_dir() { path.to_path_buf() } else { path.parent().map(Path::to_path_buf).unwrap_or_default() };
-    let mpath = if path.is_dir() { dir.join(MANIFEST) } else { path.to_path_buf() };
+    let dir: PathBuf = if path.is_dir() {
+        path.to_path_buf()
+    } else {
+        path.parent().map(Path::to_path_buf).unwrap_or_default()
+    };
+    let mpath = if path.is_dir() {
+        dir.join(MANIFEST)
+    } else {
+        path.to_path_buf()
+    };
     let text = std::fs::read_to_string(&mpath).map_err(|e| WorldError::io(&mpath, e))?;
     let m: Manifest = serde_norway::from_str(&text).map_err(|e| {
         let msg = e.to_string();
-        let field = msg.split(':').next().unwrap_or("manifest").trim().to_string();
-        WorldError::invalid(&mpath, if field.len() < 60 { field } else { "manifest".into() }, msg)
+        let field = msg
+            .split(':')
+            .next()
+            .unwrap_or("manifest")
+            .trim()
+            .to_string();
+        WorldError::invalid(
+            &mpath,
+            if field.len() < 60 {
+                field
+            } else {
+                "manifest".into()
+            },
+            msg,
+        )
     })?;
     if m.format != FORMAT_NAME {
-        return Err(WorldError::invalid(&mpath, "format", format!("expected `{FORMAT_NAME}`, found `{}`", m.format)));
+        return Err(WorldError::invalid(
+            &mpath,
+            "format",
+            format!("expected `{FORMAT_NAME}`, found `{}`", m.format),
+        ));
     }
     if m.version != FORMAT_VERSION {
-        return Err(WorldError::invalid(&mpath, "version", format!("this verti reads version {FORMAT_VERSION}, the file is version {}", m.version)));
+        return Err(WorldError::invalid(
+            &mpath,
+            "version",
+            format!(
+                "this verti reads version {FORMAT_VERSION}, the file is version {}",
+                m.version
+            ),
+        ));
     }
-    crate::scale::check_scale(m.scale).map_err(|e| WorldError::invalid(&mpath, "scale", e.to_string()))?;
+    crate::scale::check_scale(m.scale)
+        .map_err(|e| WorldError::invalid(&mpath, "scale", e.to_string()))?;
     let max_height = finite(&mpath, "max_height", m.max_height)?;
     if max_height <= 0.0 {
-        return Err(WorldError::invalid(&mpath, "max_height", "must be positive"));
+        return Err(WorldError::invalid(
+            &mpath,
+            "max_height",
+            "must be positive",
+        ));
     }
     let n = m.grid.size;
-    if !(2..=4097).contains(&n) || (n - 1) % PATCHES_PER_SIDE != 0 {
-        return Err(WorldError::invalid(&mpath, "grid.size", format!("{n} is not 16k+1 vertices in 17..=4097")));
+    if !(2..=4097).contains(&n) || !(n - 1).is_multiple_of(PATCHES_PER_SIDE) {
+        return Err(WorldError::invalid(
+            &mpath,
+            "grid.size",
+            format!("{n} is not 16k+1 vertices in 17..=4097"),
+        ));
     }
     let cell = finite(&mpath, "grid.cell", m.grid.cell)?;
     if cell <= 0.0 {
@@ -219,47 +320,118 @@ pub fn load_world(path: &Path) -> Result<World> {
     let epath = dir.join(&m.grid.elevation);
     let elev = npy::read_array2(&epath)?;
     if (elev.rows, elev.cols) != (n, n) {
-        return Err(WorldError::invalid(&epath, "shape", format!("expected ({n}, {n}) to match grid.size, found ({}, {})", elev.rows, elev.cols)));
+        return Err(WorldError::invalid(
+            &epath,
+            "shape",
+            format!(
+                "expected ({n}, {n}) to match grid.size, found ({}, {})",
+                elev.rows, elev.cols
+            ),
+        ));
     }
     if let Some(i) = elev.data.iter().position(|v| !v.is_finite()) {
-        return Err(WorldError::invalid(&epath, "data", format!("height at row {}, column {} is {}", i / n, i % n, elev.data[i])));
+        return Err(WorldError::invalid(
+            &epath,
+            "data",
+            format!(
+                "height at row {}, column {} is {}",
+                i / n,
+                i % n,
+                elev.data[i]
+            ),
+        ));
     }
 
     // patches
     if m.patches.len() != PATCHES_PER_SIDE * PATCHES_PER_SIDE {
-        return Err(WorldError::invalid(&mpath, "patches", format!("expected 256 patches, found {}", m.patches.len())));
+        return Err(WorldError::invalid(
+            &mpath,
+            "patches",
+            format!("expected 256 patches, found {}", m.patches.len()),
+        ));
     }
     for (name, soil) in &m.soils {
-        soil.validate().map_err(|e| WorldError::invalid(&mpath, format!("soils.{name}"), e))?;
+        soil.validate()
+            .map_err(|e| WorldError::invalid(&mpath, format!("soils.{name}"), e))?;
     }
     let mut patches = Vec::with_capacity(256);
     for (k, p) in m.patches.iter().enumerate() {
         let field = |f: &str| format!("patches[{k}].{f}");
         if (p.row, p.col) != (k / PATCHES_PER_SIDE, k % PATCHES_PER_SIDE) {
-            return Err(WorldError::invalid(&mpath, field("row/col"), format!("patch {k} must be row {}, col {} (row-major order), found ({}, {})", k / 16, k % 16, p.row, p.col)));
+            return Err(WorldError::invalid(
+                &mpath,
+                field("row/col"),
+                format!(
+                    "patch {k} must be row {}, col {} (row-major order), found ({}, {})",
+                    k / 16,
+                    k % 16,
+                    p.row,
+                    p.col
+                ),
+            ));
         }
         let surface = if p.class.is_deformable() {
-            let name = p.soil.as_ref().ok_or_else(|| WorldError::invalid(&mpath, field("soil"), format!("deformable class {} needs a soil", p.class)))?;
-            let soil = m.soils.get(name).ok_or_else(|| WorldError::invalid(&mpath, field("soil"), format!("unknown soil `{name}` (not in `soils`)")))?;
+            let name = p.soil.as_ref().ok_or_else(|| {
+                WorldError::invalid(
+                    &mpath,
+                    field("soil"),
+                    format!("deformable class {} needs a soil", p.class),
+                )
+            })?;
+            let soil = m.soils.get(name).ok_or_else(|| {
+                WorldError::invalid(
+                    &mpath,
+                    field("soil"),
+                    format!("unknown soil `{name}` (not in `soils`)"),
+                )
+            })?;
             if p.friction.is_some() {
-                return Err(WorldError::invalid(&mpath, field("friction"), format!("deformable class {} takes a soil, not a friction", p.class)));
+                return Err(WorldError::invalid(
+                    &mpath,
+                    field("friction"),
+                    format!("deformable class {} takes a soil, not a friction", p.class),
+                ));
             }
             Surface::Deformable { soil: *soil }
         } else {
-            let friction = p.friction.ok_or_else(|| WorldError::invalid(&mpath, field("friction"), format!("rigid class {} needs a friction", p.class)))?;
+            let friction = p.friction.ok_or_else(|| {
+                WorldError::invalid(
+                    &mpath,
+                    field("friction"),
+                    format!("rigid class {} needs a friction", p.class),
+                )
+            })?;
             if !(friction.is_finite() && (0.0..=2.0).contains(&friction)) {
-                return Err(WorldError::invalid(&mpath, field("friction"), format!("{friction} is outside [0, 2]")));
+                return Err(WorldError::invalid(
+                    &mpath,
+                    field("friction"),
+                    format!("{friction} is outside [0, 2]"),
+                ));
             }
             let restitution = p.restitution.unwrap_or(crate::surface::RIGID_RESTITUTION);
             if !(restitution.is_finite() && (0.0..=1.0).contains(&restitution)) {
-                return Err(WorldError::invalid(&mpath, field("restitution"), format!("{restitution} is outside [0, 1]")));
+                return Err(WorldError::invalid(
+                    &mpath,
+                    field("restitution"),
+                    format!("{restitution} is outside [0, 1]"),
+                ));
             }
             if p.soil.is_some() {
-                return Err(WorldError::invalid(&mpath, field("soil"), format!("rigid class {} cannot have a soil", p.class)));
+                return Err(WorldError::invalid(
+                    &mpath,
+                    field("soil"),
+                    format!("rigid class {} cannot have a soil", p.class),
+                ));
             }
-            Surface::Rigid { friction, restitution }
+            Surface::Rigid {
+                friction,
+                restitution,
+            }
         };
-        patches.push(Patch { class: p.class, surface });
+        patches.push(Patch {
+            class: p.class,
+            surface,
+        });
     }
     let patches = PatchGrid::new(patches, cell);
 
@@ -267,24 +439,71 @@ pub fn load_world(path: &Path) -> Result<World> {
     let lpath = dir.join(&m.grid.labels);
     let labels = npy::read_array2(&lpath)?;
     if (labels.rows, labels.cols) != (n, n) {
-        return Err(WorldError::invalid(&lpath, "shape", format!("expected ({n}, {n}), found ({}, {})", labels.rows, labels.cols)));
+        return Err(WorldError::invalid(
+            &lpath,
+            "shape",
+            format!(
+                "expected ({n}, {n}), found ({}, {})",
+                labels.rows, labels.cols
+            ),
+        ));
     }
     let expected = patches.label_grid(n);
-    if let Some(i) = labels.data.iter().zip(&expected).position(|(a, b)| *a != f64::from(*b)) {
-        return Err(WorldError::invalid(&lpath, "data", format!("label {} at row {}, column {} disagrees with the manifest's patch class {}", labels.data[i], i / n, i % n, expected[i])));
+    if let Some(i) = labels
+        .data
+        .iter()
+        .zip(&expected)
+        .position(|(a, b)| *a != f64::from(*b))
+    {
+        return Err(WorldError::invalid(
+            &lpath,
+            "data",
+            format!(
+                "label {} at row {}, column {} disagrees with the manifest's patch class {}",
+                labels.data[i],
+                i / n,
+                i % n,
+                expected[i]
+            ),
+        ));
     }
 
     // obstacles
     let mut obstacles = Vec::with_capacity(m.obstacles.len());
     for (k, o) in m.obstacles.iter().enumerate() {
         let built = match o {
-            ObstacleSpec::Rock { position, yaw, scale, faces } => {
-                let faces: Vec<Face> = faces.iter().map(|f| Face { normal: Vec3::new(f[0], f[1], f[2]), offset: f[3] }).collect();
-                Obstacle::rock(faces, *scale, Vec3::new(position[0], position[1], position[2]), *yaw)
+            ObstacleSpec::Rock {
+                position,
+                yaw,
+                scale,
+                faces,
+            } => {
+                let faces: Vec<Face> = faces
+                    .iter()
+                    .map(|f| Face {
+                        normal: Vec3::new(f[0], f[1], f[2]),
+                        offset: f[3],
+                    })
+                    .collect();
+                Obstacle::rock(
+                    faces,
+                    *scale,
+                    Vec3::new(position[0], position[1], position[2]),
+                    *yaw,
+                )
             }
-            ObstacleSpec::Tree { position, radius, height } => Obstacle::tree(*radius, *height, Vec3::new(position[0], position[1], position[2])),
+            ObstacleSpec::Tree {
+                position,
+                radius,
+                height,
+            } => Obstacle::tree(
+                *radius,
+                *height,
+                Vec3::new(position[0], position[1], position[2]),
+            ),
         };
-        obstacles.push(built.map_err(|e| WorldError::invalid(&mpath, format!("obstacles[{k}]"), e))?);
+        obstacles
+            .push(built.map_err(|e| WorldError::invalid(&mpath, format!("obstacles[{k}]"), e))?);
     }
 
     // tasks and paths
@@ -292,26 +511,58 @@ pub fn load_world(path: &Path) -> Result<World> {
     for (k, t) in m.tasks.iter().enumerate() {
         for (what, p) in [("start", t.start), ("goal", t.goal)] {
             if !(p[0].is_finite() && p[1].is_finite() && p[0].abs() <= half && p[1].abs() <= half) {
-                return Err(WorldError::invalid(&mpath, format!("tasks[{k}].{what}"), format!("{p:?} is not a finite point on the map (|x|, |y| <= {half})")));
+                return Err(WorldError::invalid(
+                    &mpath,
+                    format!("tasks[{k}].{what}"),
+                    format!("{p:?} is not a finite point on the map (|x|, |y| <= {half})"),
+                ));
             }
         }
         if m.tasks[..k].iter().any(|u| u.pair == t.pair) {
-            return Err(WorldError::invalid(&mpath, format!("tasks[{k}].pair"), format!("pair {} appears twice", t.pair)));
+            return Err(WorldError::invalid(
+                &mpath,
+                format!("tasks[{k}].pair"),
+                format!("pair {} appears twice", t.pair),
+            ));
         }
     }
     if m.paths.paths.len() != m.tasks.len() {
-        return Err(WorldError::invalid(&mpath, "paths.paths", format!("expected one path per task ({}), found {}", m.tasks.len(), m.paths.paths.len())));
+        return Err(WorldError::invalid(
+            &mpath,
+            "paths.paths",
+            format!(
+                "expected one path per task ({}), found {}",
+                m.tasks.len(),
+                m.paths.paths.len()
+            ),
+        ));
     }
     let clearance = finite(&mpath, "paths.clearance", m.paths.clearance)?;
     let mut paths = Vec::with_capacity(m.tasks.len());
     for (k, (p, t)) in m.paths.paths.iter().zip(&m.tasks).enumerate() {
         if p.pair != t.pair {
-            return Err(WorldError::invalid(&mpath, format!("paths.paths[{k}].pair"), format!("expected pair {} (same order as tasks), found {}", t.pair, p.pair)));
+            return Err(WorldError::invalid(
+                &mpath,
+                format!("paths.paths[{k}].pair"),
+                format!(
+                    "expected pair {} (same order as tasks), found {}",
+                    t.pair, p.pair
+                ),
+            ));
         }
-        if p.points.iter().any(|q| !(q[0].is_finite() && q[1].is_finite())) {
-            return Err(WorldError::invalid(&mpath, format!("paths.paths[{k}].points"), "contains a non-finite point"));
+        if p.points
+            .iter()
+            .any(|q| !(q[0].is_finite() && q[1].is_finite()))
+        {
+            return Err(WorldError::invalid(
+                &mpath,
+                format!("paths.paths[{k}].points"),
+                "contains a non-finite point",
+            ));
         }
-        paths.push(GlobalPath { points: p.points.clone() });
+        paths.push(GlobalPath {
+            points: p.points.clone(),
+        });
     }
 
     Ok(World {
@@ -355,7 +606,13 @@ pub fn world_dir_name(index: u32) -> String {
 }
 
 /// Writes a whole set: one directory per world plus `set.yaml`.
-pub fn save_set(worlds: &[World], name: &str, seed: Option<u64>, dir: &Path, progress: &(dyn Fn() + Sync)) -> Result<()> {
+pub fn save_set(
+    worlds: &[World],
+    name: &str,
+    seed: Option<u64>,
+    dir: &Path,
+    progress: &(dyn Fn() + Sync),
+) -> Result<()> {
     use rayon::prelude::*;
     std::fs::create_dir_all(dir).map_err(|e| WorldError::io(dir, e))?;
     worlds.par_iter().try_for_each(|w| {
@@ -369,22 +626,39 @@ pub fn save_set(worlds: &[World], name: &str, seed: Option<u64>, dir: &Path, pro
         name: name.into(),
         seed,
         scale: worlds.first().map(|w| w.meta.scale).unwrap_or(1.0),
-        worlds: worlds.iter().map(|w| world_dir_name(w.meta.index)).collect(),
+        worlds: worlds
+            .iter()
+            .map(|w| world_dir_name(w.meta.index))
+            .collect(),
     };
-    let text = crate::yaml::to_yaml(&manifest).map_err(|e| WorldError::invalid(dir.join(SET_MANIFEST), "manifest", e.to_string()))?;
-    std::fs::write(dir.join(SET_MANIFEST), text).map_err(|e| WorldError::io(dir.join(SET_MANIFEST), e))
+    let text = crate::yaml::to_yaml(&manifest)
+        .map_err(|e| WorldError::invalid(dir.join(SET_MANIFEST), "manifest", e.to_string()))?;
+    std::fs::write(dir.join(SET_MANIFEST), text)
+        .map_err(|e| WorldError::io(dir.join(SET_MANIFEST), e))
 }
 
 /// Reads a set manifest.
 pub fn read_set_manifest(dir: &Path) -> Result<SetManifest> {
     let p = dir.join(SET_MANIFEST);
     let text = std::fs::read_to_string(&p).map_err(|e| WorldError::io(&p, e))?;
-    let m: SetManifest = serde_norway::from_str(&text).map_err(|e| WorldError::invalid(&p, "manifest", e.to_string()))?;
+    let m: SetManifest = serde_norway::from_str(&text)
+        .map_err(|e| WorldError::invalid(&p, "manifest", e.to_string()))?;
     if m.format != "verti-world-set" {
-        return Err(WorldError::invalid(&p, "format", format!("expected `verti-world-set`, found `{}`", m.format)));
+        return Err(WorldError::invalid(
+            &p,
+            "format",
+            format!("expected `verti-world-set`, found `{}`", m.format),
+        ));
     }
     if m.version != FORMAT_VERSION {
-        return Err(WorldError::invalid(&p, "version", format!("this verti reads version {FORMAT_VERSION}, the file is version {}", m.version)));
+        return Err(WorldError::invalid(
+            &p,
+            "version",
+            format!(
+                "this verti reads version {FORMAT_VERSION}, the file is version {}",
+                m.version
+            ),
+        ));
     }
     Ok(m)
 }
@@ -393,6 +667,10 @@ pub fn read_set_manifest(dir: &Path) -> Result<SetManifest> {
 pub fn load_set(dir: &Path) -> Result<(SetManifest, Vec<World>)> {
     use rayon::prelude::*;
     let m = read_set_manifest(dir)?;
-    let worlds = m.worlds.par_iter().map(|w| load_world(&dir.join(w))).collect::<Result<Vec<_>>>()?;
+    let worlds = m
+        .worlds
+        .par_iter()
+        .map(|w| load_world(&dir.join(w)))
+        .collect::<Result<Vec<_>>>()?;
     Ok((m, worlds))
 }

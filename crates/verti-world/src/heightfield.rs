@@ -65,7 +65,10 @@ impl Heightfield {
     pub fn nearest_vertex(&self, x: f64, y: f64) -> (usize, usize) {
         let (c, r) = self.grid_coords(x, y);
         let m = (self.n - 1) as f64;
-        (r.round().clamp(0.0, m) as usize, c.round().clamp(0.0, m) as usize)
+        (
+            r.round().clamp(0.0, m) as usize,
+            c.round().clamp(0.0, m) as usize,
+        )
     }
     /// True when (x, y) lies on the map.
     #[inline]
@@ -77,7 +80,10 @@ impl Heightfield {
         self.heights.iter().copied().fold(f64::INFINITY, f64::min)
     }
     pub fn max_height(&self) -> f64 {
-        self.heights.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        self.heights
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// Height and the two slopes (dz/dx, dz/dy) of the triangle under (x, y). Points off the
@@ -143,8 +149,14 @@ impl Heightfield {
         let (c0, r1) = self.grid_coords(x0, y0);
         let (c1, r0) = self.grid_coords(x1, y1);
         let m = (self.n - 1) as f64;
-        let (c0, c1) = (c0.ceil().clamp(0.0, m) as usize, c1.floor().clamp(0.0, m) as usize);
-        let (r0, r1) = (r0.ceil().clamp(0.0, m) as usize, r1.floor().clamp(0.0, m) as usize);
+        let (c0, c1) = (
+            c0.ceil().clamp(0.0, m) as usize,
+            c1.floor().clamp(0.0, m) as usize,
+        );
+        let (r0, r1) = (
+            r0.ceil().clamp(0.0, m) as usize,
+            r1.floor().clamp(0.0, m) as usize,
+        );
         for r in r0..=r1.max(r0) {
             for c in c0..=c1.max(c0) {
                 if r <= r1 && c <= c1 {

@@ -19,8 +19,12 @@ use crate::heightfield::Heightfield;
 use crate::npy;
 use crate::obstacle::{Obstacle, box_faces};
 use crate::paths::DEFAULT_CLEARANCE;
-use crate::surface::{PATCHES_PER_SIDE, Patch, PatchGrid, RIGID_RESTITUTION, Surface, TerrainClass};
-use crate::world::{ElevationLevel, ObstacleDensity, Task, TerrainType, World, WorldMeta, WorldSource};
+use crate::surface::{
+    PATCHES_PER_SIDE, Patch, PatchGrid, RIGID_RESTITUTION, Surface, TerrainClass,
+};
+use crate::world::{
+    ElevationLevel, ObstacleDensity, Task, TerrainType, World, WorldMeta, WorldSource,
+};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use verti_core::Vec3;
@@ -108,15 +112,29 @@ pub struct ImportOptions {
 
 impl Default for ImportOptions {
     fn default() -> Self {
-        ImportOptions { scale: 1.0, clearance: DEFAULT_CLEARANCE, index: None }
+        ImportOptions {
+            scale: 1.0,
+            clearance: DEFAULT_CLEARANCE,
+            index: None,
+        }
     }
 }
 
+/// Obstacle positions exactly as stored in a Verti-Bench config.
+pub struct VbObstaclePositions {
+    /// (position, scale) of every rock.
+    pub rocks: Vec<(VbPoint, f64)>,
+    pub trees: Vec<VbPoint>,
+}
+
 /// The obstacle positions as stored in a config (for checks against the reference data).
-pub fn read_vb_obstacle_positions(config: &Path) -> Result<(Vec<(VbPoint, f64)>, Vec<VbPoint>)> {
+pub fn read_vb_obstacle_positions(config: &Path) -> Result<VbObstaclePositions> {
     let cfg = read_config(config)?;
     let obs = cfg.obstacles.unwrap_or_default();
-    Ok((obs.rocks.iter().map(|r| (r.position, r.scale)).collect(), obs.trees.iter().map(|t| t.position).collect()))
+    Ok(VbObstaclePositions {
+        rocks: obs.rocks.iter().map(|r| (r.position, r.scale)).collect(),
+        trees: obs.trees.iter().map(|t| t.position).collect(),
+    })
 }
 
 fn read_config(path: &Path) -> Result<VbConfig> {
@@ -134,7 +152,11 @@ pub fn read_grey_bmp(path: &Path) -> Result<(usize, usize, Vec<u8>)> {
     let mut grey = Vec::with_capacity(w * h);
     for p in rgb.pixels() {
         if p[0] != p[1] || p[1] != p[2] {
-            return Err(WorldError::invalid(path, "pixels", "expected a grey-scale heightmap, found colour pixels"));
+            return Err(WorldError::invalid(
+                path,
+                "pixels",
+                "expected a grey-scale heightmap, found colour pixels",
+            ));
         }
         grey.push(p[0]);
     }
@@ -149,70 +171,149 @@ pub fn index_from_config_name(path: &Path) -> Option<u32> {
 }
 
 /// Imports one Verti-Bench world.
-pub fn import_vb(config: &Path, heightmap: &Path, labels: Option<&Path>, options: &ImportOptions) -> Result<World> {
+pub fn import_vb(
+    config: &Path,
+    heightmap: &Path,
+    labels: Option<&Path>,
+    options: &ImportOptions,
+) -> Result<World> {
     crate::scale::check_scale(options.scale)?;
     let cfg = read_config(config)?;
     let s = options.scale;
-    let level = ElevationLevel::from_name(&cfg.terrain.difficulty)
-        .ok_or_else(|| WorldError::invalid(config, "terrain.difficulty", format!("`{}` is not low, mid or high", cfg.terrain.difficulty)))?;
+    let level = ElevationLevel::from_name(&cfg.terrain.difficulty).ok_or_else(|| {
+        WorldError::invalid(
+            config,
+            "terrain.difficulty",
+            format!("`{}` is not low, mid or high", cfg.terrain.difficulty),
+        )
+    })?;
     if !(cfg.terrain.max_height.is_finite() && cfg.terrain.max_height > 0.0) {
-        return Err(WorldError::invalid(config, "terrain.max_height", format!("{} must be a positive number", cfg.terrain.max_height)));
+        return Err(WorldError::invalid(
+            config,
+            "terrain.max_height",
+            format!("{} must be a positive number", cfg.terrain.max_height),
+        ));
     }
     if cfg.terrain.min_height != 0.0 {
-        return Err(WorldError::invalid(config, "terrain.min_height", format!("{} is not supported (Verti-Bench worlds use 0)", cfg.terrain.min_height)));
+        return Err(WorldError::invalid(
+            config,
+            "terrain.min_height",
+            format!(
+                "{} is not supported (Verti-Bench worlds use 0)",
+                cfg.terrain.min_height
+            ),
+        ));
     }
-    let terrain_type = TerrainType::from_name(&cfg.terrain_type)
-        .ok_or_else(|| WorldError::invalid(config, "terrain_type", format!("`{}` is not rigid, deformable or mixed", cfg.terrain_type)))?;
-    let density = ObstacleDensity::from_name(&cfg.obstacle_density)
-        .ok_or_else(|| WorldError::invalid(config, "obstacle_density", format!("`{}` is not sparse, medium or dense", cfg.obstacle_density)))?;
+    let terrain_type = TerrainType::from_name(&cfg.terrain_type).ok_or_else(|| {
+        WorldError::invalid(
+            config,
+            "terrain_type",
+            format!("`{}` is not rigid, deformable or mixed", cfg.terrain_type),
+        )
+    })?;
+    let density = ObstacleDensity::from_name(&cfg.obstacle_density).ok_or_else(|| {
+        WorldError::invalid(
+            config,
+            "obstacle_density",
+            format!("`{}` is not sparse, medium or dense", cfg.obstacle_density),
+        )
+    })?;
 
     // elevation
     let (rows, cols, grey) = read_grey_bmp(heightmap)?;
     if (rows, cols) != (VB_GRID, VB_GRID) {
-        return Err(WorldError::invalid(heightmap, "size", format!("expected 129x129 pixels, found {cols}x{rows}")));
+        return Err(WorldError::invalid(
+            heightmap,
+            "size",
+            format!("expected 129x129 pixels, found {cols}x{rows}"),
+        ));
     }
     let max_height = cfg.terrain.max_height * s;
-    let heights: Vec<f64> = grey.iter().map(|&g| f64::from((f64::from(g) / 255.0 * max_height) as f32)).collect();
+    let heights: Vec<f64> = grey
+        .iter()
+        .map(|&g| f64::from((f64::from(g) / 255.0 * max_height) as f32))
+        .collect();
     let terrain = Heightfield::new(VB_GRID, s, heights);
 
     // patches
     if cfg.textures.len() != PATCHES_PER_SIDE * PATCHES_PER_SIDE {
-        return Err(WorldError::invalid(config, "textures", format!("expected 256 patch records, found {}", cfg.textures.len())));
+        return Err(WorldError::invalid(
+            config,
+            "textures",
+            format!("expected 256 patch records, found {}", cfg.textures.len()),
+        ));
     }
     let mut slots: Vec<Option<Patch>> = vec![None; 256];
     for (k, t) in cfg.textures.iter().enumerate() {
         let field = |f: &str| format!("textures[{k}].{f}");
         let [i, j] = t.index;
         if i >= PATCHES_PER_SIDE || j >= PATCHES_PER_SIDE {
-            return Err(WorldError::invalid(config, field("index"), format!("[{i}, {j}] is outside the 16x16 grid")));
+            return Err(WorldError::invalid(
+                config,
+                field("index"),
+                format!("[{i}, {j}] is outside the 16x16 grid"),
+            ));
         }
-        let class = TerrainClass::from_name(&t.terrain_type)
-            .ok_or_else(|| WorldError::invalid(config, field("terrain_type"), format!("unknown class `{}`", t.terrain_type)))?;
+        let class = TerrainClass::from_name(&t.terrain_type).ok_or_else(|| {
+            WorldError::invalid(
+                config,
+                field("terrain_type"),
+                format!("unknown class `{}`", t.terrain_type),
+            )
+        })?;
         if class.is_deformable() != t.is_deformable {
-            return Err(WorldError::invalid(config, field("is_deformable"), format!("{} does not match class {class}", t.is_deformable)));
+            return Err(WorldError::invalid(
+                config,
+                field("is_deformable"),
+                format!("{} does not match class {class}", t.is_deformable),
+            ));
         }
         let surface = if let Some(soil) = class.soil() {
             Surface::Deformable { soil }
         } else {
-            let friction = t.friction.ok_or_else(|| WorldError::invalid(config, field("friction"), format!("rigid patch ({class}) has no friction")))?;
+            let friction = t.friction.ok_or_else(|| {
+                WorldError::invalid(
+                    config,
+                    field("friction"),
+                    format!("rigid patch ({class}) has no friction"),
+                )
+            })?;
             if !(friction.is_finite() && (0.0..=2.0).contains(&friction)) {
-                return Err(WorldError::invalid(config, field("friction"), format!("{friction} is outside [0, 2]")));
+                return Err(WorldError::invalid(
+                    config,
+                    field("friction"),
+                    format!("{friction} is outside [0, 2]"),
+                ));
             }
-            Surface::Rigid { friction, restitution: t.restitution.unwrap_or(RIGID_RESTITUTION) }
+            Surface::Rigid {
+                friction,
+                restitution: t.restitution.unwrap_or(RIGID_RESTITUTION),
+            }
         };
         let slot = &mut slots[i * PATCHES_PER_SIDE + j];
         if slot.is_some() {
-            return Err(WorldError::invalid(config, field("index"), format!("patch [{i}, {j}] appears twice")));
+            return Err(WorldError::invalid(
+                config,
+                field("index"),
+                format!("patch [{i}, {j}] appears twice"),
+            ));
         }
         *slot = Some(Patch { class, surface });
     }
-    let patches: Vec<Patch> = slots.into_iter().map(|p| p.expect("256 distinct indices fill the grid")).collect();
+    let patches: Vec<Patch> = slots
+        .into_iter()
+        .map(|p| p.expect("256 distinct indices fill the grid"))
+        .collect();
     let patches = PatchGrid::new(patches, s);
 
     if let Some(lpath) = labels {
         let arr = npy::read_array2(lpath)?;
         if (arr.rows, arr.cols) != (VB_GRID, VB_GRID) {
-            return Err(WorldError::invalid(lpath, "shape", format!("expected (129, 129), found ({}, {})", arr.rows, arr.cols)));
+            return Err(WorldError::invalid(
+                lpath,
+                "shape",
+                format!("expected (129, 129), found ({}, {})", arr.rows, arr.cols),
+            ));
         }
         // Interior pixels only: the shared patch borders carry the later patch's label, and
         // a few borders of mixed worlds keep pre-conversion labels (spec §1.5).
@@ -221,7 +322,15 @@ pub fn import_vb(config: &Path, heightmap: &Path, labels: Option<&Path>, options
                 let v = arr.data[(8 * i + 4) * VB_GRID + 8 * j + 4];
                 let class = patches.get(i, j).class;
                 if v != f64::from(class.id()) {
-                    return Err(WorldError::invalid(lpath, format!("label at row {}, column {}", 8 * i + 4, 8 * j + 4), format!("{v} disagrees with patch [{i}, {j}] = {class} ({}) in {}", class.id(), config.display())));
+                    return Err(WorldError::invalid(
+                        lpath,
+                        format!("label at row {}, column {}", 8 * i + 4, 8 * j + 4),
+                        format!(
+                            "{v} disagrees with patch [{i}, {j}] = {class} ({}) in {}",
+                            class.id(),
+                            config.display()
+                        ),
+                    ));
                 }
             }
         }
@@ -231,30 +340,61 @@ pub fn import_vb(config: &Path, heightmap: &Path, labels: Option<&Path>, options
     let obs = cfg.obstacles.unwrap_or_default();
     let (want_rocks, want_trees) = density.counts();
     if obs.rocks.len() != want_rocks || obs.trees.len() != want_trees {
-        return Err(WorldError::invalid(config, "obstacles", format!("{density} density means {want_rocks} rocks and {want_trees} trees, found {} and {}", obs.rocks.len(), obs.trees.len())));
+        return Err(WorldError::invalid(
+            config,
+            "obstacles",
+            format!(
+                "{density} density means {want_rocks} rocks and {want_trees} trees, found {} and {}",
+                obs.rocks.len(),
+                obs.trees.len()
+            ),
+        ));
     }
     let mut obstacles = Vec::with_capacity(obs.rocks.len() + obs.trees.len());
     for (k, r) in obs.rocks.iter().enumerate() {
         let p = r.position;
         if !(p.x.is_finite() && p.y.is_finite() && r.scale.is_finite() && r.scale > 0.0) {
-            return Err(WorldError::invalid(config, format!("obstacles.rocks[{k}]"), "position and scale must be finite, scale > 0"));
+            return Err(WorldError::invalid(
+                config,
+                format!("obstacles.rocks[{k}]"),
+                "position and scale must be finite, scale > 0",
+            ));
         }
-        let size = Vec3::new(VB_ROCK_BOX[0] * r.scale * s, VB_ROCK_BOX[1] * r.scale * s, VB_ROCK_BOX[2] * r.scale * s);
+        let size = Vec3::new(
+            VB_ROCK_BOX[0] * r.scale * s,
+            VB_ROCK_BOX[1] * r.scale * s,
+            VB_ROCK_BOX[2] * r.scale * s,
+        );
         let (x, y) = (p.x * s, p.y * s);
-        let (ground, _) = terrain.range_in_box(x - 0.5 * size.x, y - 0.5 * size.y, x + 0.5 * size.x, y + 0.5 * size.y);
+        let (ground, _) = terrain.range_in_box(
+            x - 0.5 * size.x,
+            y - 0.5 * size.y,
+            x + 0.5 * size.x,
+            y + 0.5 * size.y,
+        );
         let z = ground - BURY * s + 0.5 * size.z;
-        obstacles.push(Obstacle::rock(box_faces(size), r.scale, Vec3::new(x, y, z), 0.0).map_err(|e| WorldError::invalid(config, format!("obstacles.rocks[{k}]"), e))?);
+        obstacles.push(
+            Obstacle::rock(box_faces(size), r.scale, Vec3::new(x, y, z), 0.0)
+                .map_err(|e| WorldError::invalid(config, format!("obstacles.rocks[{k}]"), e))?,
+        );
     }
     for (k, t) in obs.trees.iter().enumerate() {
         let p = t.position;
         if !(p.x.is_finite() && p.y.is_finite()) {
-            return Err(WorldError::invalid(config, format!("obstacles.trees[{k}]"), "position must be finite"));
+            return Err(WorldError::invalid(
+                config,
+                format!("obstacles.trees[{k}]"),
+                "position must be finite",
+            ));
         }
         let (x, y) = (p.x * s, p.y * s);
         let r = 0.5 * VB_TREE_BOX[0] * s;
         let (ground, _) = terrain.range_in_box(x - r, y - r, x + r, y + r);
         let h = VB_TREE_BOX[2] * s + BURY * s;
-        obstacles.push(Obstacle::tree(r, h, Vec3::new(x, y, ground - BURY * s + 0.5 * h)).map_err(|e| WorldError::invalid(config, format!("obstacles.trees[{k}]"), e))?);
+        obstacles.push(
+            Obstacle::tree(r, h, Vec3::new(x, y, ground - BURY * s + 0.5 * h))
+                .map_err(|e| WorldError::invalid(config, format!("obstacles.trees[{k}]"), e))?,
+        );
     }
 
     // tasks
@@ -263,29 +403,55 @@ pub fn import_vb(config: &Path, heightmap: &Path, labels: Option<&Path>, options
     for (k, pair) in cfg.positions.iter().enumerate() {
         let get = |v: &Vec<f64>, what: &str| -> Result<[f64; 2]> {
             if v.len() < 2 || !v[0].is_finite() || !v[1].is_finite() {
-                return Err(WorldError::invalid(config, format!("positions[{k}].{what}"), "needs finite [x, y, z]"));
+                return Err(WorldError::invalid(
+                    config,
+                    format!("positions[{k}].{what}"),
+                    "needs finite [x, y, z]",
+                ));
             }
             let p = [v[0] * s, v[1] * s];
             if p[0].abs() > half || p[1].abs() > half {
-                return Err(WorldError::invalid(config, format!("positions[{k}].{what}"), format!("{p:?} is off the map")));
+                return Err(WorldError::invalid(
+                    config,
+                    format!("positions[{k}].{what}"),
+                    format!("{p:?} is off the map"),
+                ));
             }
             Ok(p)
         };
-        tasks.push(Task { pair: k as u32, start: get(&pair.start, "start")?, goal: get(&pair.goal, "goal")? });
+        tasks.push(Task {
+            pair: k as u32,
+            start: get(&pair.start, "start")?,
+            goal: get(&pair.goal, "goal")?,
+        });
     }
     if tasks.is_empty() {
-        return Err(WorldError::invalid(config, "positions", "no start/goal pairs"));
+        return Err(WorldError::invalid(
+            config,
+            "positions",
+            "no start/goal pairs",
+        ));
     }
 
     let clearance = options.clearance * s;
     let paths = plan_paths(&obstacles, &terrain, &tasks, clearance);
-    let index = options.index.or_else(|| index_from_config_name(config)).unwrap_or(1);
-    let stem = config.file_stem().and_then(|x| x.to_str()).unwrap_or("world").to_string();
+    let index = options
+        .index
+        .or_else(|| index_from_config_name(config))
+        .unwrap_or(1);
+    let stem = config
+        .file_stem()
+        .and_then(|x| x.to_str())
+        .unwrap_or("world")
+        .to_string();
     Ok(World {
         meta: WorldMeta {
             name: format!("vb/{stem}"),
             index,
-            source: WorldSource::VertiBench { config: file_name(config), heightmap: file_name(heightmap) },
+            source: WorldSource::VertiBench {
+                config: file_name(config),
+                heightmap: file_name(heightmap),
+            },
             level,
             terrain_type,
             density,
@@ -302,7 +468,10 @@ pub fn import_vb(config: &Path, heightmap: &Path, labels: Option<&Path>, options
 }
 
 fn file_name(p: &Path) -> String {
-    p.file_name().and_then(|n| n.to_str()).unwrap_or_default().to_string()
+    p.file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or_default()
+        .to_string()
 }
 
 /// One world's files found in a Verti-Bench folder.
@@ -326,18 +495,36 @@ pub fn scan_vb_dir(dir: &Path) -> Result<Vec<VbWorldFiles>> {
         if !(name.starts_with("config") && name.ends_with(".yaml")) {
             continue;
         }
-        let Some(index) = index_from_config_name(&path) else { continue };
-        let level = name.trim_end_matches(".yaml").split('_').nth(1).unwrap_or("");
-        let candidates = [dir.join(format!("world{index}.bmp")), dir.join(format!("{index}.bmp")), dir.join("../../Worlds").join(format!("{index}.bmp"))];
+        let Some(index) = index_from_config_name(&path) else {
+            continue;
+        };
+        let level = name
+            .trim_end_matches(".yaml")
+            .split('_')
+            .nth(1)
+            .unwrap_or("");
+        let candidates = [
+            dir.join(format!("world{index}.bmp")),
+            dir.join(format!("{index}.bmp")),
+            dir.join("../../Worlds").join(format!("{index}.bmp")),
+        ];
         let heightmap = candidates.iter().find(|p| p.exists()).cloned().ok_or_else(|| {
             WorldError::invalid(&path, "heightmap", format!("no heightmap found for world {index} (looked for world{index}.bmp, {index}.bmp, ../../Worlds/{index}.bmp)"))
         })?;
         let labels = Some(dir.join(format!("labels{index}_{level}.npy"))).filter(|p| p.exists());
-        out.push(VbWorldFiles { config: path, heightmap, labels, index });
+        out.push(VbWorldFiles {
+            config: path,
+            heightmap,
+            labels,
+            index,
+        });
     }
     out.sort_by_key(|f| f.index);
     if out.is_empty() {
-        return Err(WorldError::Argument(format!("{}: no Verti-Bench configs (configN_LEVEL.yaml) found", dir.display())));
+        return Err(WorldError::Argument(format!(
+            "{}: no Verti-Bench configs (configN_LEVEL.yaml) found",
+            dir.display()
+        )));
     }
     Ok(out)
 }

@@ -21,10 +21,11 @@ pub mod world;
 pub mod yaml;
 
 pub use error::{Result, WorldError};
-pub use npy::read_array2;
 pub use heightfield::Heightfield;
+pub use npy::read_array2;
 pub use obstacle::{Face, Obstacle, ObstacleShape};
 pub use surface::{Patch, PatchGrid, SoilParams, Surface, TerrainClass};
 pub use world::{
-    ElevationLevel, GlobalPath, ObstacleDensity, Task, TaskId, TerrainType, World, WorldMeta, WorldSource,
+    ElevationLevel, GlobalPath, ObstacleDensity, Task, TaskId, TerrainType, World, WorldMeta,
+    WorldSource,
 };

@@ -45,13 +45,26 @@ pub struct Obstacle {
 
 impl Obstacle {
     /// Builds a rock. Fails when the faces do not bound a non-empty solid.
-    pub fn rock(faces: Vec<Face>, scale: f64, position: Vec3, yaw: f64) -> Result<Obstacle, String> {
+    pub fn rock(
+        faces: Vec<Face>,
+        scale: f64,
+        position: Vec3,
+        yaw: f64,
+    ) -> Result<Obstacle, String> {
         if faces.len() < 4 {
-            return Err(format!("a rock needs at least 4 faces, got {}", faces.len()));
+            return Err(format!(
+                "a rock needs at least 4 faces, got {}",
+                faces.len()
+            ));
         }
         for (i, f) in faces.iter().enumerate() {
-            if !f.normal.is_finite() || !f.offset.is_finite() || (f.normal.norm() - 1.0).abs() > 1e-6 {
-                return Err(format!("face {i} must have a finite unit normal and offset"));
+            if !f.normal.is_finite()
+                || !f.offset.is_finite()
+                || (f.normal.norm() - 1.0).abs() > 1e-6
+            {
+                return Err(format!(
+                    "face {i} must have a finite unit normal and offset"
+                ));
             }
         }
         if !position.is_finite() || !yaw.is_finite() || !scale.is_finite() || scale <= 0.0 {
@@ -62,7 +75,10 @@ impl Obstacle {
             return Err("the faces do not enclose a solid (fewer than 4 vertices)".into());
         }
         let rotation = Quat::from_axis_angle(Vec3::Z, yaw);
-        let vertices: Vec<Vec3> = local.iter().map(|v| position + rotation.rotate(*v)).collect();
+        let vertices: Vec<Vec3> = local
+            .iter()
+            .map(|v| position + rotation.rotate(*v))
+            .collect();
         let pts: Vec<[f64; 2]> = vertices.iter().map(|v| [v.x, v.y]).collect();
         let footprint = convex_hull_2d(&pts);
         let radius_xy = vertices
@@ -70,7 +86,10 @@ impl Obstacle {
             .map(|v| (*v - position).norm_xy())
             .fold(0.0, f64::max);
         let z_min = vertices.iter().map(|v| v.z).fold(f64::INFINITY, f64::min);
-        let z_max = vertices.iter().map(|v| v.z).fold(f64::NEG_INFINITY, f64::max);
+        let z_max = vertices
+            .iter()
+            .map(|v| v.z)
+            .fold(f64::NEG_INFINITY, f64::max);
         Ok(Obstacle {
             shape: ObstacleShape::Rock { faces, scale },
             position,
@@ -87,7 +106,9 @@ impl Obstacle {
     /// Builds a tree (vertical cylinder centred at `position`).
     pub fn tree(radius: f64, height: f64, position: Vec3) -> Result<Obstacle, String> {
         if !(radius.is_finite() && radius > 0.0 && height.is_finite() && height > 0.0) {
-            return Err(format!("tree radius {radius} and height {height} must be positive"));
+            return Err(format!(
+                "tree radius {radius} and height {height} must be positive"
+            ));
         }
         if !position.is_finite() {
             return Err("tree position must be finite".into());
@@ -166,7 +187,11 @@ impl Obstacle {
                 let r = (q.x * q.x + q.y * q.y).sqrt();
                 let dr = r - radius;
                 let dz = q.z.abs() - 0.5 * height;
-                let radial = if r > 1e-12 { Vec3::new(q.x / r, q.y / r, 0.0) } else { Vec3::X };
+                let radial = if r > 1e-12 {
+                    Vec3::new(q.x / r, q.y / r, 0.0)
+                } else {
+                    Vec3::X
+                };
                 let vertical = Vec3::new(0.0, 0.0, q.z.signum());
                 if dr > 0.0 && dz > 0.0 {
                     let d = (dr * dr + dz * dz).sqrt();
@@ -194,7 +219,9 @@ pub fn polytope_vertices(faces: &[Face]) -> Vec<Vec3> {
                 if det.abs() < 1e-9 {
                     continue;
                 }
-                let p = (b.cross(c) * faces[i].offset + c.cross(a) * faces[j].offset + a.cross(b) * faces[k].offset)
+                let p = (b.cross(c) * faces[i].offset
+                    + c.cross(a) * faces[j].offset
+                    + a.cross(b) * faces[k].offset)
                     / det;
                 if faces.iter().all(|f| f.normal.dot(p) <= f.offset + 1e-7)
                     && !out.iter().any(|q| (*q - p).norm() < 1e-6)
@@ -215,7 +242,9 @@ pub fn convex_hull_2d(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
     if pts.len() < 3 {
         return pts;
     }
-    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
     let mut hull: Vec<[f64; 2]> = Vec::with_capacity(2 * pts.len());
     for &p in &pts {
         while hull.len() >= 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
@@ -225,7 +254,8 @@ pub fn convex_hull_2d(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
     }
     let lower_len = hull.len() + 1;
     for &p in pts.iter().rev().skip(1) {
-        while hull.len() >= lower_len && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
+        while hull.len() >= lower_len && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+        {
             hull.pop();
         }
         hull.push(p);
@@ -245,7 +275,11 @@ pub fn polygon_signed_distance(poly: &[[f64; 2]], x: f64, y: f64) -> f64 {
         let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
         let (px, py) = (x - a[0], y - a[1]);
         let len2 = ex * ex + ey * ey;
-        let t = if len2 > 0.0 { ((px * ex + py * ey) / len2).clamp(0.0, 1.0) } else { 0.0 };
+        let t = if len2 > 0.0 {
+            ((px * ex + py * ey) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         let (dx, dy) = (px - t * ex, py - t * ey);
         best = best.min((dx * dx + dy * dy).sqrt());
         if ex * py - ey * px < 0.0 {
@@ -259,12 +293,30 @@ pub fn polygon_signed_distance(poly: &[[f64; 2]], x: f64, y: f64) -> f64 {
 pub fn box_faces(size: Vec3) -> Vec<Face> {
     let h = size * 0.5;
     vec![
-        Face { normal: Vec3::X, offset: h.x },
-        Face { normal: -Vec3::X, offset: h.x },
-        Face { normal: Vec3::Y, offset: h.y },
-        Face { normal: -Vec3::Y, offset: h.y },
-        Face { normal: Vec3::Z, offset: h.z },
-        Face { normal: -Vec3::Z, offset: h.z },
+        Face {
+            normal: Vec3::X,
+            offset: h.x,
+        },
+        Face {
+            normal: -Vec3::X,
+            offset: h.x,
+        },
+        Face {
+            normal: Vec3::Y,
+            offset: h.y,
+        },
+        Face {
+            normal: -Vec3::Y,
+            offset: h.y,
+        },
+        Face {
+            normal: Vec3::Z,
+            offset: h.z,
+        },
+        Face {
+            normal: -Vec3::Z,
+            offset: h.z,
+        },
     ]
 }
 
@@ -274,7 +326,13 @@ mod tests {
 
     #[test]
     fn box_rock_geometry() {
-        let rock = Obstacle::rock(box_faces(Vec3::new(4.0, 2.0, 3.0)), 1.0, Vec3::new(10.0, 5.0, 1.5), 0.0).unwrap();
+        let rock = Obstacle::rock(
+            box_faces(Vec3::new(4.0, 2.0, 3.0)),
+            1.0,
+            Vec3::new(10.0, 5.0, 1.5),
+            0.0,
+        )
+        .unwrap();
         assert_eq!(rock.vertices().len(), 8);
         assert_eq!(rock.footprint().len(), 4);
         assert_eq!(rock.z_range(), (0.0, 3.0));
@@ -290,7 +348,13 @@ mod tests {
 
     #[test]
     fn rotated_rock_and_tree() {
-        let rock = Obstacle::rock(box_faces(Vec3::new(4.0, 2.0, 2.0)), 1.0, Vec3::ZERO, std::f64::consts::FRAC_PI_2).unwrap();
+        let rock = Obstacle::rock(
+            box_faces(Vec3::new(4.0, 2.0, 2.0)),
+            1.0,
+            Vec3::ZERO,
+            std::f64::consts::FRAC_PI_2,
+        )
+        .unwrap();
         // long axis now along y
         assert!(rock.footprint_distance(0.0, 1.9) < 0.0);
         assert!(rock.footprint_distance(1.9, 0.0) > 0.0);

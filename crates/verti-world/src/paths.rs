@@ -52,7 +52,14 @@ impl<'a> PlanningGrid<'a> {
                 }
             }
         }
-        PlanningGrid { n, cell, half, clearance, blocked, obstacles }
+        PlanningGrid {
+            n,
+            cell,
+            half,
+            clearance,
+            blocked,
+            obstacles,
+        }
     }
 
     pub fn is_blocked(&self, row: usize, col: usize) -> bool {
@@ -61,7 +68,10 @@ impl<'a> PlanningGrid<'a> {
 
     fn xy(&self, idx: usize) -> [f64; 2] {
         let (r, c) = (idx / self.n, idx % self.n);
-        [c as f64 * self.cell - self.half, self.half - r as f64 * self.cell]
+        [
+            c as f64 * self.cell - self.half,
+            self.half - r as f64 * self.cell,
+        ]
     }
 
     fn nearest(&self, p: [f64; 2]) -> usize {
@@ -115,7 +125,11 @@ impl<'a> PlanningGrid<'a> {
         let mut closed = vec![false; n * n];
         let mut open = BinaryHeap::new();
         best[s] = 0.0;
-        open.push(Node { f: octile(s), h: octile(s), idx: s });
+        open.push(Node {
+            f: octile(s),
+            h: octile(s),
+            idx: s,
+        });
         const MOVES: [(i64, i64, f64); 8] = [
             (0, 1, 1.0),
             (1, 0, 1.0),
@@ -165,7 +179,11 @@ impl<'a> PlanningGrid<'a> {
                     best[j] = cand;
                     parent[j] = idx;
                     let h = octile(j);
-                    open.push(Node { f: cand + h, h, idx: j });
+                    open.push(Node {
+                        f: cand + h,
+                        h,
+                        idx: j,
+                    });
                 }
             }
         }
@@ -237,7 +255,9 @@ impl Ord for Node {
     /// Max-heap order reversed: smallest f first, then smallest h (deeper nodes), then index,
     /// so the search is fully deterministic.
     fn cmp(&self, o: &Self) -> Ordering {
-        o.f.total_cmp(&self.f).then(o.h.total_cmp(&self.h)).then(o.idx.cmp(&self.idx))
+        o.f.total_cmp(&self.f)
+            .then(o.h.total_cmp(&self.h))
+            .then(o.idx.cmp(&self.idx))
     }
 }
 
@@ -251,24 +271,39 @@ mod tests {
     fn straight_line_when_free_and_optimal_lengths() {
         let grid = PlanningGrid::new(21, 1.0, &[], 1.0);
         let p = grid.plan([-8.0, -8.0], [8.0, 8.0]).unwrap();
-        let len: f64 = p.windows(2).map(|w| ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt()).sum();
+        let len: f64 = p
+            .windows(2)
+            .map(|w| ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt())
+            .sum();
         assert!((len - 16.0 * std::f64::consts::SQRT_2).abs() < 1e-9);
         // raw A* cost on a knight-like offset equals the octile distance
         let raw = grid.astar([0.0, 0.0], [5.0, 2.0]).unwrap();
-        let raw_len: f64 = raw.windows(2).map(|w| ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt()).sum();
+        let raw_len: f64 = raw
+            .windows(2)
+            .map(|w| ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt())
+            .sum();
         assert!((raw_len - (3.0 + 2.0 * std::f64::consts::SQRT_2)).abs() < 1e-9);
     }
 
     #[test]
     fn detours_around_a_wall_with_clearance() {
-        let wall = Obstacle::rock(box_faces(Vec3::new(2.0, 30.0, 2.0)), 1.0, Vec3::new(0.0, -5.0, 1.0), 0.0).unwrap();
+        let wall = Obstacle::rock(
+            box_faces(Vec3::new(2.0, 30.0, 2.0)),
+            1.0,
+            Vec3::new(0.0, -5.0, 1.0),
+            0.0,
+        )
+        .unwrap();
         let obstacles = vec![wall];
         let grid = PlanningGrid::new(41, 1.0, &obstacles, 1.5);
         let p = grid.plan([-10.0, 0.0], [10.0, 0.0]).unwrap();
         for w in p.windows(2) {
             assert!(grid.segment_clear(w[0], w[1]));
         }
-        assert!(p.iter().any(|q| q[1] > 10.0 + 1.5), "path must go around the top of the wall");
+        assert!(
+            p.iter().any(|q| q[1] > 10.0 + 1.5),
+            "path must go around the top of the wall"
+        );
         assert_eq!(p[0], [-10.0, 0.0]);
         assert_eq!(*p.last().unwrap(), [10.0, 0.0]);
     }
@@ -279,7 +314,15 @@ mod tests {
         let mut obstacles = Vec::new();
         for k in 0..16 {
             let a = k as f64 / 16.0 * std::f64::consts::TAU;
-            obstacles.push(Obstacle::rock(box_faces(Vec3::new(3.0, 3.0, 2.0)), 1.0, Vec3::new(6.0 * a.cos(), 6.0 * a.sin(), 1.0), a).unwrap());
+            obstacles.push(
+                Obstacle::rock(
+                    box_faces(Vec3::new(3.0, 3.0, 2.0)),
+                    1.0,
+                    Vec3::new(6.0 * a.cos(), 6.0 * a.sin(), 1.0),
+                    a,
+                )
+                .unwrap(),
+            );
         }
         let grid = PlanningGrid::new(41, 1.0, &obstacles, 1.0);
         assert!(grid.plan([-18.0, 0.0], [0.0, 0.0]).is_none());

@@ -8,21 +8,26 @@ use crate::error::{Result, WorldError};
 pub fn parse_scale(text: &str) -> Result<f64> {
     let t = text.trim();
     let value = if let Some((num, den)) = t.split_once('/') {
-        let n: f64 = num
-            .trim()
-            .parse()
-            .map_err(|_| WorldError::Argument(format!("scale `{text}`: numerator `{num}` is not a number")))?;
-        let d: f64 = den
-            .trim()
-            .parse()
-            .map_err(|_| WorldError::Argument(format!("scale `{text}`: denominator `{den}` is not a number")))?;
+        let n: f64 = num.trim().parse().map_err(|_| {
+            WorldError::Argument(format!("scale `{text}`: numerator `{num}` is not a number"))
+        })?;
+        let d: f64 = den.trim().parse().map_err(|_| {
+            WorldError::Argument(format!(
+                "scale `{text}`: denominator `{den}` is not a number"
+            ))
+        })?;
         if d == 0.0 {
-            return Err(WorldError::Argument(format!("scale `{text}`: denominator is zero")));
+            return Err(WorldError::Argument(format!(
+                "scale `{text}`: denominator is zero"
+            )));
         }
         n / d
     } else {
-        t.parse()
-            .map_err(|_| WorldError::Argument(format!("scale `{text}` is not a number or a fraction like 1/6")))?
+        t.parse().map_err(|_| {
+            WorldError::Argument(format!(
+                "scale `{text}` is not a number or a fraction like 1/6"
+            ))
+        })?
     };
     check_scale(value)?;
     Ok(value)
@@ -42,7 +47,11 @@ pub fn check_scale(value: f64) -> Result<()> {
 pub fn scale_label(value: f64) -> String {
     for den in 1..=20u32 {
         if (value * f64::from(den) - 1.0).abs() < 1e-9 {
-            return if den == 1 { "1".into() } else { format!("1/{den}") };
+            return if den == 1 {
+                "1".into()
+            } else {
+                format!("1/{den}")
+            };
         }
     }
     format!("{value}")

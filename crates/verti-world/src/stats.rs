@@ -12,7 +12,7 @@ use serde::Serialize;
 use std::fmt;
 
 /// Histogram bin width at full scale, metres (multiplied by the set's scale).
-pub const HISTOGRAM_BIN_WIDTH: f64 = 0.25;
+pub const HISTOGRAM_BIN_WIDTH: f64 = 0.1;
 /// Histogram range at full scale, metres: the highest level's ceiling.
 pub const HISTOGRAM_RANGE: f64 = MAX_RELIEF_FULL_SCALE;
 
@@ -115,7 +115,7 @@ pub struct LevelElevation {
     pub ceiling: f64,
     /// Left edge of bin 0, metres (always 0).
     pub bin_start: f64,
-    /// Bin width, metres (0.25 m times the scale).
+    /// Bin width, metres (0.1 m times the scale).
     pub bin_width: f64,
     /// Vertex counts per bin; bins cover [0, 16 m · scale).
     pub counts: Vec<u64>,

@@ -52,14 +52,17 @@ impl TerrainClass {
         TerrainClass::Rock,
         TerrainClass::Wood,
     ];
-    pub const DEFORMABLE: [TerrainClass; 3] = [TerrainClass::Mud, TerrainClass::Sand, TerrainClass::Snow];
+    pub const DEFORMABLE: [TerrainClass; 3] =
+        [TerrainClass::Mud, TerrainClass::Sand, TerrainClass::Snow];
 
     /// Verti-Bench label id (0..9).
     pub fn id(self) -> u8 {
         self as u8
     }
     pub fn from_id(id: i64) -> Option<TerrainClass> {
-        usize::try_from(id).ok().and_then(|i| Self::ALL.get(i).copied())
+        usize::try_from(id)
+            .ok()
+            .and_then(|i| Self::ALL.get(i).copied())
     }
     pub fn name(self) -> &'static str {
         match self {
@@ -79,7 +82,10 @@ impl TerrainClass {
         Self::ALL.iter().copied().find(|c| c.name() == name)
     }
     pub fn is_deformable(self) -> bool {
-        matches!(self, TerrainClass::Mud | TerrainClass::Sand | TerrainClass::Snow)
+        matches!(
+            self,
+            TerrainClass::Mud | TerrainClass::Sand | TerrainClass::Snow
+        )
     }
     /// (mean, standard deviation) of the friction coefficient of a rigid class.
     pub fn friction_distribution(self) -> Option<(f64, f64)> {
@@ -234,7 +240,11 @@ pub struct PatchGrid {
 
 impl PatchGrid {
     pub fn new(patches: Vec<Patch>, cell: f64) -> Self {
-        assert_eq!(patches.len(), PATCHES_PER_SIDE * PATCHES_PER_SIDE, "patch count");
+        assert_eq!(
+            patches.len(),
+            PATCHES_PER_SIDE * PATCHES_PER_SIDE,
+            "patch count"
+        );
         let patch_size = CELLS_PER_PATCH as f64 * cell;
         PatchGrid {
             patches,
@@ -256,8 +266,12 @@ impl PatchGrid {
     #[inline]
     pub fn index_at(&self, x: f64, y: f64) -> (usize, usize) {
         let m = (PATCHES_PER_SIDE - 1) as f64;
-        let col = ((x + self.half_extent) / self.patch_size).floor().clamp(0.0, m) as usize;
-        let row = ((self.half_extent - y) / self.patch_size).floor().clamp(0.0, m) as usize;
+        let col = ((x + self.half_extent) / self.patch_size)
+            .floor()
+            .clamp(0.0, m) as usize;
+        let row = ((self.half_extent - y) / self.patch_size)
+            .floor()
+            .clamp(0.0, m) as usize;
         (row, col)
     }
     #[inline]
@@ -317,7 +331,10 @@ mod tests {
     fn patch_lookup_matches_grid() {
         let p = Patch {
             class: TerrainClass::Clay,
-            surface: Surface::Rigid { friction: 0.6, restitution: RIGID_RESTITUTION },
+            surface: Surface::Rigid {
+                friction: 0.6,
+                restitution: RIGID_RESTITUTION,
+            },
         };
         let mut patches = vec![p; 256];
         patches[17].class = TerrainClass::Rock; // row 1, col 1

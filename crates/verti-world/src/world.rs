@@ -19,7 +19,11 @@ pub enum ElevationLevel {
 pub const MAX_RELIEF_FULL_SCALE: f64 = 16.0;
 
 impl ElevationLevel {
-    pub const ALL: [ElevationLevel; 3] = [ElevationLevel::Low, ElevationLevel::Mid, ElevationLevel::High];
+    pub const ALL: [ElevationLevel; 3] = [
+        ElevationLevel::Low,
+        ElevationLevel::Mid,
+        ElevationLevel::High,
+    ];
     /// 30 / 60 / 100 % of the maximum relief.
     pub fn fraction(self) -> f64 {
         match self {
@@ -40,7 +44,9 @@ impl ElevationLevel {
         }
     }
     pub fn from_name(s: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|l| l.name() == s || (s == "medium" && *l == ElevationLevel::Mid))
+        Self::ALL
+            .into_iter()
+            .find(|l| l.name() == s || (s == "medium" && *l == ElevationLevel::Mid))
     }
 }
 
@@ -54,7 +60,11 @@ pub enum TerrainType {
 }
 
 impl TerrainType {
-    pub const ALL: [TerrainType; 3] = [TerrainType::Rigid, TerrainType::Deformable, TerrainType::Mixed];
+    pub const ALL: [TerrainType; 3] = [
+        TerrainType::Rigid,
+        TerrainType::Deformable,
+        TerrainType::Mixed,
+    ];
     pub fn name(self) -> &'static str {
         match self {
             TerrainType::Rigid => "rigid",
@@ -77,7 +87,11 @@ pub enum ObstacleDensity {
 }
 
 impl ObstacleDensity {
-    pub const ALL: [ObstacleDensity; 3] = [ObstacleDensity::Sparse, ObstacleDensity::Medium, ObstacleDensity::Dense];
+    pub const ALL: [ObstacleDensity; 3] = [
+        ObstacleDensity::Sparse,
+        ObstacleDensity::Medium,
+        ObstacleDensity::Dense,
+    ];
     /// (rocks, trees): 10 + 1, 20 + 2, 40 + 3.
     pub fn counts(self) -> (usize, usize) {
         match self {
@@ -155,7 +169,10 @@ impl TaskId {
         if n == 0 {
             return None;
         }
-        Some(TaskId { world: (n - 1) / PAIRS_PER_WORLD + 1, pair: (n - 1) % PAIRS_PER_WORLD })
+        Some(TaskId {
+            world: (n - 1) / PAIRS_PER_WORLD + 1,
+            pair: (n - 1) % PAIRS_PER_WORLD,
+        })
     }
 }
 
@@ -216,7 +233,10 @@ pub struct World {
 
 impl World {
     pub fn task_id(&self, pair: u32) -> TaskId {
-        TaskId { world: self.meta.index, pair }
+        TaskId {
+            world: self.meta.index,
+            pair,
+        }
     }
     /// Class label grid (n x n, Verti-Bench label ids).
     pub fn labels(&self) -> Vec<u8> {
@@ -240,14 +260,23 @@ mod tests {
         for n in [1u32, 10, 11, 999, 1000] {
             assert_eq!(TaskId::from_number(n).unwrap().number(), n);
         }
-        assert_eq!(TaskId::from_number(1000).unwrap(), TaskId { world: 100, pair: 9 });
+        assert_eq!(
+            TaskId::from_number(1000).unwrap(),
+            TaskId {
+                world: 100,
+                pair: 9
+            }
+        );
         assert_eq!(TaskId::from_number(0), None);
     }
 
     #[test]
     fn levels() {
         assert_eq!(ElevationLevel::Low.max_height(), 16.0 * 0.3);
-        assert_eq!(ElevationLevel::from_name("medium"), Some(ElevationLevel::Mid));
+        assert_eq!(
+            ElevationLevel::from_name("medium"),
+            Some(ElevationLevel::Mid)
+        );
         assert_eq!(ObstacleDensity::Dense.counts(), (40, 3));
     }
 }

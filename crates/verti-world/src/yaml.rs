@@ -39,7 +39,10 @@ fn flow_len(v: &Value) -> usize {
 
 fn flow_record(v: &Value) -> Result<String, serde_norway::Error> {
     let Value::Mapping(m) = v else { return flow(v) };
-    let parts = m.iter().map(|(k, x)| Ok(format!("{}: {}", scalar(k)?, flow(x)?))).collect::<Result<Vec<_>, serde_norway::Error>>()?;
+    let parts = m
+        .iter()
+        .map(|(k, x)| Ok(format!("{}: {}", scalar(k)?, flow(x)?)))
+        .collect::<Result<Vec<_>, serde_norway::Error>>()?;
     Ok(format!("{{{}}}", parts.join(", ")))
 }
 
@@ -49,7 +52,13 @@ fn scalar(v: &Value) -> Result<String, serde_norway::Error> {
 
 fn flow(v: &Value) -> Result<String, serde_norway::Error> {
     match v {
-        Value::Sequence(s) => Ok(format!("[{}]", s.iter().map(flow).collect::<Result<Vec<_>, _>>()?.join(", "))),
+        Value::Sequence(s) => Ok(format!(
+            "[{}]",
+            s.iter()
+                .map(flow)
+                .collect::<Result<Vec<_>, _>>()?
+                .join(", ")
+        )),
         _ => scalar(v),
     }
 }
@@ -64,7 +73,11 @@ fn emit_block(v: &Value, indent: usize, out: &mut String) -> Result<(), serde_no
             for (k, val) in m {
                 let key = scalar(k)?;
                 if is_flow(val) || matches!(val, Value::Mapping(mm) if mm.is_empty()) {
-                    let text = if matches!(val, Value::Mapping(_)) { "{}".to_string() } else { flow(val)? };
+                    let text = if matches!(val, Value::Mapping(_)) {
+                        "{}".to_string()
+                    } else {
+                        flow(val)?
+                    };
                     out.push_str(&format!("{pad}{key}: {text}\n"));
                 } else if let Value::Sequence(s) = val {
                     out.push_str(&format!("{pad}{key}:\n"));
@@ -135,7 +148,11 @@ mod tests {
     fn round_trips_and_is_compact() {
         let v = Outer {
             title: "a: b".into(),
-            list: vec![Inner { name: "yes".into(), xs: vec![0.1, 1e-300, -3.0], grid: vec![[1.0, 2.0], [3.0, 4.5]] }],
+            list: vec![Inner {
+                name: "yes".into(),
+                xs: vec![0.1, 1e-300, -3.0],
+                grid: vec![[1.0, 2.0], [3.0, 4.5]],
+            }],
             empty: vec![],
             map: [("k".to_string(), 1)].into_iter().collect(),
             weird: "- x".into(),

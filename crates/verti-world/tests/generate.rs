@@ -27,7 +27,10 @@ fn read_tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
             if p.is_dir() {
                 stack.push(p);
             } else {
-                out.insert(p.strip_prefix(dir).unwrap().to_path_buf(), std::fs::read(&p).unwrap());
+                out.insert(
+                    p.strip_prefix(dir).unwrap().to_path_buf(),
+                    std::fs::read(&p).unwrap(),
+                );
             }
         }
     }
@@ -37,7 +40,10 @@ fn read_tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 #[test]
 fn generation_is_byte_identical_across_runs_and_thread_counts() {
     let a = default_set();
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
     let b = pool.install(default_set);
     assert_eq!(a, b);
     let (da, db) = (tmp("det-a"), tmp("det-b"));
@@ -65,7 +71,10 @@ fn composition_matches_the_paper() {
     assert_eq!(count(&|w| w.meta.level == ElevationLevel::Mid), 33);
     assert_eq!(count(&|w| w.meta.level == ElevationLevel::High), 33);
     assert_eq!(count(&|w| w.meta.terrain_type == TerrainType::Rigid), 60);
-    assert_eq!(count(&|w| w.meta.terrain_type == TerrainType::Deformable), 30);
+    assert_eq!(
+        count(&|w| w.meta.terrain_type == TerrainType::Deformable),
+        30
+    );
     assert_eq!(count(&|w| w.meta.terrain_type == TerrainType::Mixed), 10);
     for d in ObstacleDensity::ALL {
         assert!((33..=34).contains(&count(&|w| w.meta.density == d)));
@@ -75,21 +84,39 @@ fn composition_matches_the_paper() {
         assert_eq!(w.obstacles.iter().filter(|o| o.is_rock()).count(), rocks);
         assert_eq!(w.obstacles.len(), rocks + trees);
         // heights within the level's ceiling
-        assert!(w.terrain.min_height() >= 0.0 && w.terrain.max_height() <= w.meta.level.max_height());
+        assert!(
+            w.terrain.min_height() >= 0.0 && w.terrain.max_height() <= w.meta.level.max_height()
+        );
         // patch kinds follow the world type
-        let soil = w.patches.patches().iter().filter(|p| p.surface.is_deformable()).count();
+        let soil = w
+            .patches
+            .patches()
+            .iter()
+            .filter(|p| p.surface.is_deformable())
+            .count();
         match w.meta.terrain_type {
             TerrainType::Rigid => assert_eq!(soil, 0),
             TerrainType::Deformable => assert_eq!(soil, 256),
-            TerrainType::Mixed => assert!(soil > 0 && soil < 256, "{}: {soil} soil patches", w.meta.name),
+            TerrainType::Mixed => assert!(
+                soil > 0 && soil < 256,
+                "{}: {soil} soil patches",
+                w.meta.name
+            ),
         }
     }
     // relief grows with the level (mean relief low < mid < high)
     let relief = |l: ElevationLevel| {
         let ws: Vec<&World> = worlds.iter().filter(|w| w.meta.level == l).collect();
-        ws.iter().map(|w| w.terrain.max_height() - w.terrain.min_height()).sum::<f64>() / ws.len() as f64
+        ws.iter()
+            .map(|w| w.terrain.max_height() - w.terrain.min_height())
+            .sum::<f64>()
+            / ws.len() as f64
     };
-    let (lo, mid, hi) = (relief(ElevationLevel::Low), relief(ElevationLevel::Mid), relief(ElevationLevel::High));
+    let (lo, mid, hi) = (
+        relief(ElevationLevel::Low),
+        relief(ElevationLevel::Mid),
+        relief(ElevationLevel::High),
+    );
     assert!(lo < mid && mid < hi, "{lo} {mid} {hi}");
     // the reference's mean relief per level is 1.8 / 3.5 / 5.9 m
     assert!((hi - 5.9).abs() < 1.5, "high relief {hi}");
@@ -98,12 +125,20 @@ fn composition_matches_the_paper() {
 #[test]
 fn ten_metre_rule_holds() {
     for w in default_set() {
-        let centres: Vec<[f64; 2]> = w.obstacles.iter().map(|o| [o.position().x, o.position().y]).collect();
+        let centres: Vec<[f64; 2]> = w
+            .obstacles
+            .iter()
+            .map(|o| [o.position().x, o.position().y])
+            .collect();
         let points: Vec<[f64; 2]> = w.tasks.iter().flat_map(|t| [t.start, t.goal]).collect();
         for (i, a) in centres.iter().enumerate() {
             for b in centres[i + 1..].iter().chain(&points) {
                 let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
-                assert!(d >= 10.0, "{}: obstacle {i} is {d:.2} m from another obstacle or a start/goal", w.meta.name);
+                assert!(
+                    d >= 10.0,
+                    "{}: obstacle {i} is {d:.2} m from another obstacle or a start/goal",
+                    w.meta.name
+                );
             }
         }
     }
@@ -112,9 +147,19 @@ fn ten_metre_rule_holds() {
 #[test]
 fn every_global_path_connects_start_to_goal_with_clearance() {
     for w in default_set() {
-        let grid = PlanningGrid::new(w.terrain.size(), w.terrain.cell(), &w.obstacles, w.path_clearance);
+        let grid = PlanningGrid::new(
+            w.terrain.size(),
+            w.terrain.cell(),
+            &w.obstacles,
+            w.path_clearance,
+        );
         for (t, p) in w.tasks.iter().zip(&w.paths) {
-            assert!(p.points.len() >= 2, "{} pair {}: no path", w.meta.name, t.pair);
+            assert!(
+                p.points.len() >= 2,
+                "{} pair {}: no path",
+                w.meta.name,
+                t.pair
+            );
             assert_eq!(p.points[0], t.start);
             assert_eq!(*p.points.last().unwrap(), t.goal);
             // dense check of every segment against the exact obstacle footprints
@@ -123,9 +168,17 @@ fn every_global_path_connects_start_to_goal_with_clearance() {
                 let k = (len / 0.05).ceil() as usize;
                 for i in 0..=k {
                     let f = i as f64 / k.max(1) as f64;
-                    let (x, y) = (s[0][0] + f * (s[1][0] - s[0][0]), s[0][1] + f * (s[1][1] - s[0][1]));
+                    let (x, y) = (
+                        s[0][0] + f * (s[1][0] - s[0][0]),
+                        s[0][1] + f * (s[1][1] - s[0][1]),
+                    );
                     let d = w.obstacle_distance(x, y);
-                    assert!(d >= w.path_clearance - 1e-9, "{} pair {}: path passes {d:.3} m from an obstacle", w.meta.name, t.pair);
+                    assert!(
+                        d >= w.path_clearance - 1e-9,
+                        "{} pair {}: path passes {d:.3} m from an obstacle",
+                        w.meta.name,
+                        t.pair
+                    );
                     assert!(w.terrain.contains(x, y));
                 }
             }
@@ -137,8 +190,23 @@ fn every_global_path_connects_start_to_goal_with_clearance() {
 
 #[test]
 fn scaled_sets_scale_every_length() {
-    let full = generate_set(&SetConfig { count: 3, ..Default::default() }, &|| {}).unwrap();
-    let small = generate_set(&SetConfig { count: 3, scale: 0.1, ..Default::default() }, &|| {}).unwrap();
+    let full = generate_set(
+        &SetConfig {
+            count: 3,
+            ..Default::default()
+        },
+        &|| {},
+    )
+    .unwrap();
+    let small = generate_set(
+        &SetConfig {
+            count: 3,
+            scale: 0.1,
+            ..Default::default()
+        },
+        &|| {},
+    )
+    .unwrap();
     for (f, s) in full.iter().zip(&small) {
         assert!((s.terrain.half_extent() - 6.4).abs() < 1e-12);
         assert!((s.tasks[0].distance() - 12.0).abs() < 1e-9);
@@ -157,7 +225,15 @@ fn scaled_sets_scale_every_length() {
 /// the field and the problem.
 #[test]
 fn corrupt_worlds_give_clear_errors() {
-    let w = generate_set(&SetConfig { count: 1, ..Default::default() }, &|| {}).unwrap().remove(0);
+    let w = generate_set(
+        &SetConfig {
+            count: 1,
+            ..Default::default()
+        },
+        &|| {},
+    )
+    .unwrap()
+    .remove(0);
     let base = tmp("corrupt");
     save_world(&w, &base).unwrap();
     assert_eq!(load_world(&base).unwrap(), w);
@@ -174,37 +250,88 @@ fn corrupt_worlds_give_clear_errors() {
         std::fs::remove_dir_all(&d).ok();
         e
     };
-    let first_friction = manifest.split("friction: ").nth(1).unwrap().split(',').next().unwrap().to_string();
+    let first_friction = manifest
+        .split("friction: ")
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .to_string();
 
-    let e = case("version", &|d| std::fs::write(d.join("world.yaml"), manifest.replace("version: 1", "version: 7")).unwrap());
-    assert!(e.contains("world.yaml") && e.contains("version") && e.contains('7'), "{e}");
-    let e = case("friction", &|d| std::fs::write(d.join("world.yaml"), manifest.replacen(&first_friction, "5.0", 1)).unwrap());
+    let e = case("version", &|d| {
+        std::fs::write(
+            d.join("world.yaml"),
+            manifest.replace("version: 1", "version: 7"),
+        )
+        .unwrap()
+    });
+    assert!(
+        e.contains("world.yaml") && e.contains("version") && e.contains('7'),
+        "{e}"
+    );
+    let e = case("friction", &|d| {
+        std::fs::write(
+            d.join("world.yaml"),
+            manifest.replacen(&first_friction, "5.0", 1),
+        )
+        .unwrap()
+    });
     assert!(e.contains("patches[0].friction") && e.contains("5"), "{e}");
-    let e = case("class", &|d| std::fs::write(d.join("world.yaml"), manifest.replacen("class: ", "class: lava", 1)).unwrap());
+    let e = case("class", &|d| {
+        std::fs::write(
+            d.join("world.yaml"),
+            manifest.replacen("class: ", "class: lava", 1),
+        )
+        .unwrap()
+    });
     assert!(e.contains("world.yaml") && e.contains("lava"), "{e}");
-    let e = case("yaml", &|d| std::fs::write(d.join("world.yaml"), &manifest[..manifest.len() / 2]).unwrap());
+    let e = case("yaml", &|d| {
+        std::fs::write(d.join("world.yaml"), &manifest[..manifest.len() / 2]).unwrap()
+    });
     assert!(e.contains("world.yaml"), "{e}");
-    let e = case("npy-missing", &|d| std::fs::remove_file(d.join("elevation.npy")).unwrap());
+    let e = case("npy-missing", &|d| {
+        std::fs::remove_file(d.join("elevation.npy")).unwrap()
+    });
     assert!(e.contains("elevation.npy"), "{e}");
-    let e = case("npy-garbage", &|d| std::fs::write(d.join("elevation.npy"), b"\x93NUMPY garbage").unwrap());
+    let e = case("npy-garbage", &|d| {
+        std::fs::write(d.join("elevation.npy"), b"\x93NUMPY garbage").unwrap()
+    });
     assert!(e.contains("elevation.npy"), "{e}");
-    let e = case("npy-shape", &|d| verti_world::npy::write_f32(&d.join("elevation.npy"), 3, 3, &[0.0; 9]).unwrap());
+    let e = case("npy-shape", &|d| {
+        verti_world::npy::write_f32(&d.join("elevation.npy"), 3, 3, &[0.0; 9]).unwrap()
+    });
     assert!(e.contains("elevation.npy") && e.contains("shape"), "{e}");
     let e = case("npy-nan", &|d| {
         let mut h: Vec<f32> = w.terrain.heights().iter().map(|&v| v as f32).collect();
         h[130] = f32::NAN;
         verti_world::npy::write_f32(&d.join("elevation.npy"), 129, 129, &h).unwrap();
     });
-    assert!(e.contains("elevation.npy") && e.contains("row 1, column 1") && e.contains("NaN"), "{e}");
+    assert!(
+        e.contains("elevation.npy") && e.contains("row 1, column 1") && e.contains("NaN"),
+        "{e}"
+    );
     let e = case("labels", &|d| {
         let mut l: Vec<i32> = w.labels().into_iter().map(i32::from).collect();
         l[5] = (l[5] + 1) % 10;
         verti_world::npy::write_i32(&d.join("labels.npy"), 129, 129, &l).unwrap();
     });
     assert!(e.contains("labels.npy") && e.contains("disagrees"), "{e}");
-    let e = case("task", &|d| std::fs::write(d.join("world.yaml"), manifest.replacen("start: [60.0, 0.0]", "start: [600.0, 0.0]", 1)).unwrap());
+    let e = case("task", &|d| {
+        std::fs::write(
+            d.join("world.yaml"),
+            manifest.replacen("start: [60.0, 0.0]", "start: [600.0, 0.0]", 1),
+        )
+        .unwrap()
+    });
     assert!(e.contains("tasks[0].start") && e.contains("600"), "{e}");
-    let e = case("unknown-field", &|d| std::fs::write(d.join("world.yaml"), manifest.replace("density:", "densty: dense\ndensity:")).unwrap());
+    let e = case("unknown-field", &|d| {
+        std::fs::write(
+            d.join("world.yaml"),
+            manifest.replace("density:", "densty: dense\ndensity:"),
+        )
+        .unwrap()
+    });
     assert!(e.contains("densty"), "{e}");
     std::fs::remove_dir_all(base).ok();
 }

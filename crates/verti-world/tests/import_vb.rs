@@ -4,15 +4,21 @@
 //! and pass without checking.
 
 use std::path::PathBuf;
-use verti_world::import_vb::{ImportOptions, VB_GRID, import_vb, read_grey_bmp, read_vb_obstacle_positions, scan_vb_dir};
+use verti_world::import_vb::{
+    ImportOptions, VB_GRID, import_vb, read_grey_bmp, read_vb_obstacle_positions, scan_vb_dir,
+};
 use verti_world::{ObstacleShape, Surface, TerrainClass, npy};
 
 fn vb_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/verti-bench-data/worlds");
+    let dir =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/verti-bench-data/worlds");
     if dir.is_dir() {
         Some(dir)
     } else {
-        eprintln!("SKIPPED: {} is absent; Verti-Bench import checks not run", dir.display());
+        eprintln!(
+            "SKIPPED: {} is absent; Verti-Bench import checks not run",
+            dir.display()
+        );
         None
     }
 }
@@ -24,7 +30,9 @@ fn round_half_even(v: f64) -> f64 {
 /// Height of the reference's 129 m-wide planning mesh at (x, y): the same BMP stretched by
 /// 129/128 (spec §1.4), i.e. our terrain at (x, y)·128/129.
 fn npy_mesh_height(world: &verti_world::World, x: f64, y: f64) -> f64 {
-    world.terrain.height_at(x * 128.0 / 129.0, y * 128.0 / 129.0)
+    world
+        .terrain
+        .height_at(x * 128.0 / 129.0, y * 128.0 / 129.0)
 }
 
 #[test]
@@ -35,8 +43,13 @@ fn all_shared_worlds_import_and_match_their_files() {
     let mut z_errors = Vec::new();
     for f in &files {
         let labels = f.labels.as_deref().expect("every shared world has labels");
-        let w = import_vb(&f.config, &f.heightmap, Some(labels), &ImportOptions::default())
-            .unwrap_or_else(|e| panic!("{}: {e}", f.config.display()));
+        let w = import_vb(
+            &f.config,
+            &f.heightmap,
+            Some(labels),
+            &ImportOptions::default(),
+        )
+        .unwrap_or_else(|e| panic!("{}: {e}", f.config.display()));
         assert_eq!(w.meta.index, f.index);
 
         // counts
@@ -44,7 +57,12 @@ fn all_shared_worlds_import_and_match_their_files() {
         assert_eq!(w.obstacles.iter().filter(|o| o.is_rock()).count(), rocks);
         assert_eq!(w.obstacles.len(), rocks + trees);
         assert_eq!(w.tasks.len(), 10);
-        assert_eq!(w.paths.iter().filter(|p| !p.points.is_empty()).count(), 10, "{}: every task has a path", w.meta.name);
+        assert_eq!(
+            w.paths.iter().filter(|p| !p.points.is_empty()).count(),
+            10,
+            "{}: every task has a path",
+            w.meta.name
+        );
 
         // heights: grey/255 * max_height at every pixel
         let (_, _, grey) = read_grey_bmp(&f.heightmap).unwrap();
@@ -55,14 +73,21 @@ fn all_shared_worlds_import_and_match_their_files() {
 
         // The stored obstacle z is the reference's planning-mesh height read at its placement
         // pixel (spec §3.9): reproduce it from our terrain within the spec's tolerance (8 cm).
-        let (vb_rocks, vb_trees) = read_vb_obstacle_positions(&f.config).unwrap();
-        for p in vb_rocks.iter().map(|r| r.0).chain(vb_trees.iter().copied()) {
+        let vb = read_vb_obstacle_positions(&f.config).unwrap();
+        for p in vb.rocks.iter().map(|r| r.0).chain(vb.trees.iter().copied()) {
             let col = round_half_even((p.x + 58.05) * 1291.0 / 116.1);
             let row = round_half_even((-p.y + 58.05) * 1291.0 / 116.1);
             let step = 129.0 / 1290.0;
             let h = npy_mesh_height(&w, -64.5 + col * step, 64.5 - row * step);
             let err = p.z - h;
-            assert!(err.abs() < 0.08, "{}: obstacle at ({:.2}, {:.2}) stored z {:.3}, mesh {h:.3}", w.meta.name, p.x, p.y, p.z);
+            assert!(
+                err.abs() < 0.08,
+                "{}: obstacle at ({:.2}, {:.2}) stored z {:.3}, mesh {h:.3}",
+                w.meta.name,
+                p.x,
+                p.y,
+                p.z
+            );
             z_errors.push(err.abs());
         }
 
@@ -88,7 +113,13 @@ fn all_shared_worlds_import_and_match_their_files() {
             }
         }
         let reference: Vec<bool> = obs.iter().map(|&g| g == 255).collect();
-        assert_eq!(raster, reference, "{}: obstacle footprints differ from {}", w.meta.name, obs_bmp.display());
+        assert_eq!(
+            raster,
+            reference,
+            "{}: obstacle footprints differ from {}",
+            w.meta.name,
+            obs_bmp.display()
+        );
 
         // per-patch class, friction and soil against the labels file and the config
         let labels = npy::read_array2(labels).unwrap();
@@ -98,7 +129,10 @@ fn all_shared_worlds_import_and_match_their_files() {
                 let label = labels.data[(8 * i + 4) * VB_GRID + 8 * j + 4] as i64;
                 assert_eq!(Some(patch.class), TerrainClass::from_id(label));
                 match patch.surface {
-                    Surface::Rigid { friction, restitution } => {
+                    Surface::Rigid {
+                        friction,
+                        restitution,
+                    } => {
                         assert!(!patch.class.is_deformable());
                         assert!((0.1..=1.0).contains(&friction));
                         assert_eq!(restitution, 0.01);
@@ -110,25 +144,55 @@ fn all_shared_worlds_import_and_match_their_files() {
     }
     z_errors.sort_by(f64::total_cmp);
     let median = z_errors[z_errors.len() / 2];
-    assert!(median < 0.01, "median obstacle-z error {median} m (spec: 5 mm)");
+    assert!(
+        median < 0.01,
+        "median obstacle-z error {median} m (spec: 5 mm)"
+    );
 }
 
 #[test]
 fn frictions_are_copied_from_the_config() {
     let Some(dir) = vb_dir() else { return };
     let config = dir.join("config12_high.yaml");
-    let w = import_vb(&config, &dir.join("world12.bmp"), None, &ImportOptions::default()).unwrap();
+    let w = import_vb(
+        &config,
+        &dir.join("world12.bmp"),
+        None,
+        &ImportOptions::default(),
+    )
+    .unwrap();
     // first record of config12_high.yaml: patch [0, 0], clay, friction 0.5712382558117638
     assert_eq!(w.patches.get(0, 0).class, TerrainClass::Clay);
-    assert_eq!(w.patches.get(0, 0).surface, Surface::Rigid { friction: 0.5712382558117638, restitution: 0.01 });
+    assert_eq!(
+        w.patches.get(0, 0).surface,
+        Surface::Rigid {
+            friction: 0.5712382558117638,
+            restitution: 0.01
+        }
+    );
 }
 
 #[test]
 fn scaled_import_scales_every_length() {
     let Some(dir) = vb_dir() else { return };
-    let full = import_vb(&dir.join("config12_high.yaml"), &dir.join("world12.bmp"), None, &ImportOptions::default()).unwrap();
-    let opts = ImportOptions { scale: 0.1, ..Default::default() };
-    let small = import_vb(&dir.join("config12_high.yaml"), &dir.join("world12.bmp"), None, &opts).unwrap();
+    let full = import_vb(
+        &dir.join("config12_high.yaml"),
+        &dir.join("world12.bmp"),
+        None,
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    let opts = ImportOptions {
+        scale: 0.1,
+        ..Default::default()
+    };
+    let small = import_vb(
+        &dir.join("config12_high.yaml"),
+        &dir.join("world12.bmp"),
+        None,
+        &opts,
+    )
+    .unwrap();
     assert!((small.terrain.half_extent() - 6.4).abs() < 1e-12);
     assert!((small.terrain.max_height() - 0.1 * full.terrain.max_height()).abs() < 1e-5);
     assert!((small.tasks[0].distance() - 12.0).abs() < 1e-9);
@@ -143,22 +207,61 @@ fn bad_inputs_name_the_file_and_field() {
     let good = std::fs::read_to_string(dir.join("config12_high.yaml")).unwrap();
 
     let bad_level = tmp.join("config12_high.yaml");
-    std::fs::write(&bad_level, good.replace("difficulty: high", "difficulty: extreme")).unwrap();
-    let e = import_vb(&bad_level, &dir.join("world12.bmp"), None, &ImportOptions::default()).unwrap_err().to_string();
-    assert!(e.contains("config12_high.yaml") && e.contains("terrain.difficulty") && e.contains("extreme"), "{e}");
+    std::fs::write(
+        &bad_level,
+        good.replace("difficulty: high", "difficulty: extreme"),
+    )
+    .unwrap();
+    let e = import_vb(
+        &bad_level,
+        &dir.join("world12.bmp"),
+        None,
+        &ImportOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("config12_high.yaml")
+            && e.contains("terrain.difficulty")
+            && e.contains("extreme"),
+        "{e}"
+    );
 
     let bad_class = tmp.join("config13_low.yaml");
-    std::fs::write(&bad_class, good.replacen("terrain_type: clay", "terrain_type: lava", 1)).unwrap();
-    let e = import_vb(&bad_class, &dir.join("world12.bmp"), None, &ImportOptions::default()).unwrap_err().to_string();
+    std::fs::write(
+        &bad_class,
+        good.replacen("terrain_type: clay", "terrain_type: lava", 1),
+    )
+    .unwrap();
+    let e = import_vb(
+        &bad_class,
+        &dir.join("world12.bmp"),
+        None,
+        &ImportOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("textures[") && e.contains("lava"), "{e}");
 
     let not_bmp = tmp.join("world.bmp");
     std::fs::write(&not_bmp, b"BMnot really a bitmap").unwrap();
-    let e = import_vb(&dir.join("config12_high.yaml"), &not_bmp, None, &ImportOptions::default()).unwrap_err().to_string();
+    let e = import_vb(
+        &dir.join("config12_high.yaml"),
+        &not_bmp,
+        None,
+        &ImportOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("world.bmp") && e.contains("BMP"), "{e}");
 
     // labels of another world disagree with this config
-    let e = import_vb(&dir.join("config12_high.yaml"), &dir.join("world12.bmp"), Some(&dir.join("labels13_low.npy")), &ImportOptions::default());
+    let e = import_vb(
+        &dir.join("config12_high.yaml"),
+        &dir.join("world12.bmp"),
+        Some(&dir.join("labels13_low.npy")),
+        &ImportOptions::default(),
+    );
     if let Err(e) = e {
         assert!(e.to_string().contains("labels13_low.npy"), "{e}");
     }

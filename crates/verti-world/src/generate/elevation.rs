@@ -54,6 +54,17 @@ impl Default for ProceduralRock {
     }
 }
 
+/// One elliptic rock to stamp: centre and semi-axes in cells, rotation, height above `lift`.
+struct Rock {
+    cx: f64,
+    cy: f64,
+    a: f64,
+    b: f64,
+    theta: f64,
+    amp: f64,
+    lift: f64,
+}
+
 /// Working grid with `max`/`add` stamping of elliptic rocks.
 struct Field {
     n: usize,
@@ -63,7 +74,16 @@ struct Field {
 impl Field {
     /// Stamps a half-ellipsoid rock (semi-axes a, b in cells, rotated by theta) of height
     /// `amp` on top of `lift`, combined with `max`.
-    fn rock(&mut self, cx: f64, cy: f64, a: f64, b: f64, theta: f64, amp: f64, lift: f64) {
+    fn rock(&mut self, rock: Rock) {
+        let Rock {
+            cx,
+            cy,
+            a,
+            b,
+            theta,
+            amp,
+            lift,
+        } = rock;
         let (s, c) = (sin(theta), cos(theta));
         let n = self.n as i64;
         let x0 = ((cx - a - 1.0).floor() as i64).max(0);
@@ -113,7 +133,10 @@ fn undulation(rng: &mut Rng, n: usize, lattice: usize) -> Vec<f64> {
     let m = lattice + 3; // padding for the 4-tap kernel
     let g: Vec<f64> = (0..m * m).map(|_| rng.normal()).collect();
     let cr = |p0: f64, p1: f64, p2: f64, p3: f64, t: f64| {
-        0.5 * (2.0 * p1 + (-p0 + p2) * t + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t * t + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * t * t * t)
+        0.5 * (2.0 * p1
+            + (-p0 + p2) * t
+            + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t * t
+            + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * t * t * t)
     };
     let mut out = vec![0.0; n * n];
     for y in 0..n {
@@ -127,7 +150,13 @@ fn undulation(rng: &mut Rng, n: usize, lattice: usize) -> Vec<f64> {
             let mut col = [0.0; 4];
             for (k, cv) in col.iter_mut().enumerate() {
                 let row = (iy + k) * m;
-                *cv = cr(g[row + ix], g[row + ix + 1], g[row + ix + 2], g[row + ix + 3], tx);
+                *cv = cr(
+                    g[row + ix],
+                    g[row + ix + 1],
+                    g[row + ix + 2],
+                    g[row + ix + 3],
+                    tx,
+                );
             }
             out[y * n + x] = cr(col[0], col[1], col[2], col[3], ty);
         }
@@ -142,7 +171,10 @@ impl ElevationSource for ProceduralRock {
 
     fn generate(&self, rng: &mut Rng, n: usize) -> Vec<f64> {
         let nf = n as f64;
-        let mut f = Field { n, v: vec![0.0; n * n] };
+        let mut f = Field {
+            n,
+            v: vec![0.0; n * n],
+        };
         let (amin, amax) = self.rock_size;
         let mean_area = std::f64::consts::PI * (0.5 * (amin + amax)).powi(2) * 0.75;
 
@@ -155,7 +187,15 @@ impl ElevationSource for ProceduralRock {
             let b = a * rng.range(0.5, 1.0);
             let theta = rng.range(0.0, std::f64::consts::PI);
             let amp = 1.0 + self.rock_height_spread * rng.normal();
-            f.rock(cx, cy, a, b, theta, amp.max(0.2), 0.0);
+            f.rock(Rock {
+                cx,
+                cy,
+                a,
+                b,
+                theta,
+                amp: amp.max(0.2),
+                lift: 0.0,
+            });
         }
 
         // Ridges: chains of elongated rocks along a wandering line, standing a little proud.
@@ -170,7 +210,17 @@ impl ElevationSource for ProceduralRock {
                 x += 2.5 * cos(heading);
                 y += 2.5 * sin(heading);
                 let a = rng.range(3.0, 4.5);
-                f.rock(x, y, a, a * rng.range(0.45, 0.7), heading, rng.range(0.8, 1.2), 0.35);
+                let b = a * rng.range(0.45, 0.7);
+                let amp = rng.range(0.8, 1.2);
+                f.rock(Rock {
+                    cx: x,
+                    cy: y,
+                    a,
+                    b,
+                    theta: heading,
+                    amp,
+                    lift: 0.35,
+                });
             }
         }
 
@@ -178,15 +228,18 @@ impl ElevationSource for ProceduralRock {
         let boulders = rng.int_inclusive(2, 5);
         for _ in 0..boulders {
             let a = rng.range(3.5, 6.0);
-            f.rock(
-                rng.range(0.0, nf),
-                rng.range(0.0, nf),
+            let (cx, cy) = (rng.range(0.0, nf), rng.range(0.0, nf));
+            let b = a * rng.range(0.6, 1.0);
+            let theta = rng.range(0.0, std::f64::consts::PI);
+            f.rock(Rock {
+                cx,
+                cy,
                 a,
-                a * rng.range(0.6, 1.0),
-                rng.range(0.0, std::f64::consts::PI),
-                rng.range(0.9, 1.6),
-                0.6,
-            );
+                b,
+                theta,
+                amp: rng.range(0.9, 1.6),
+                lift: 0.6,
+            });
         }
 
         // Low-frequency undulation under everything.
@@ -199,7 +252,12 @@ impl ElevationSource for ProceduralRock {
         let pits = rng.int_inclusive(self.pits.0, self.pits.1);
         for _ in 0..pits {
             let deep = if rng.uniform() < 0.15 { 2.2 } else { 1.0 };
-            f.pit(rng.range(0.0, nf), rng.range(0.0, nf), rng.range(1.5, 3.5), rng.range(0.9, 2.1) * deep);
+            f.pit(
+                rng.range(0.0, nf),
+                rng.range(0.0, nf),
+                rng.range(1.5, 3.5),
+                rng.range(0.9, 2.1) * deep,
+            );
         }
 
         // Ditches: narrow channels along random walks.
@@ -312,7 +370,10 @@ mod tests {
         assert!((acc.std - 0.036).abs() < 0.008, "{acc:?}");
         assert!((acc.autocorrelation[0] - 0.78).abs() < 0.08, "{acc:?}");
         assert!((acc.autocorrelation[1] - 0.51).abs() < 0.1, "{acc:?}");
-        assert!(acc.skewness < 0.0, "rock beds have a heavy lower tail: {acc:?}");
+        assert!(
+            acc.skewness < 0.0,
+            "rock beds have a heavy lower tail: {acc:?}"
+        );
         assert!(acc.kurtosis > 3.5, "heavier tails than a Gaussian: {acc:?}");
     }
 }

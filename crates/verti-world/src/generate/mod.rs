@@ -16,8 +16,8 @@ use crate::paths::{DEFAULT_CLEARANCE, PlanningGrid};
 use crate::scale::check_scale;
 use crate::surface::PatchGrid;
 use crate::world::{
-    ElevationLevel, GlobalPath, ObstacleDensity, PAIRS_PER_WORLD, TASK_CIRCLE_RADIUS, Task, TerrainType, World,
-    WorldMeta, WorldSource,
+    ElevationLevel, GlobalPath, ObstacleDensity, PAIRS_PER_WORLD, TASK_CIRCLE_RADIUS, Task,
+    TerrainType, World, WorldMeta, WorldSource,
 };
 use elevation::{ElevationSource, ProceduralRock};
 use rayon::prelude::*;
@@ -40,7 +40,12 @@ pub struct SetConfig {
 
 impl Default for SetConfig {
     fn default() -> Self {
-        SetConfig { seed: 0, count: 100, scale: 1.0, clearance: DEFAULT_CLEARANCE }
+        SetConfig {
+            seed: 0,
+            count: 100,
+            scale: 1.0,
+            clearance: DEFAULT_CLEARANCE,
+        }
     }
 }
 
@@ -67,11 +72,18 @@ impl SetConfig {
 /// first group), so 100 worlds split 1:1:1 are 34/33/33 and 6:3:1 are 60/30/10.
 pub fn apportion(count: u32, weights: &[f64]) -> Vec<u32> {
     let total: f64 = weights.iter().sum();
-    let exact: Vec<f64> = weights.iter().map(|w| w / total * f64::from(count)).collect();
+    let exact: Vec<f64> = weights
+        .iter()
+        .map(|w| w / total * f64::from(count))
+        .collect();
     let mut out: Vec<u32> = exact.iter().map(|e| e.floor() as u32).collect();
     let mut left = count - out.iter().sum::<u32>();
     let mut order: Vec<usize> = (0..weights.len()).collect();
-    order.sort_by(|&a, &b| (exact[b] - exact[b].floor()).total_cmp(&(exact[a] - exact[a].floor())).then(a.cmp(&b)));
+    order.sort_by(|&a, &b| {
+        (exact[b] - exact[b].floor())
+            .total_cmp(&(exact[a] - exact[a].floor()))
+            .then(a.cmp(&b))
+    });
     for i in order {
         if left == 0 {
             break;
@@ -94,10 +106,25 @@ fn stratified<T: Copy>(rng: &mut Rng, count: u32, values: &[T], weights: &[f64])
 /// The (level, type, density) of every world of a set, in world order.
 pub fn composition(config: &SetConfig) -> Vec<(ElevationLevel, TerrainType, ObstacleDensity)> {
     let mut rng = Rng::derive(config.seed, "composition", 0);
-    let levels = stratified(&mut rng, config.count, &ElevationLevel::ALL, &[1.0, 1.0, 1.0]);
+    let levels = stratified(
+        &mut rng,
+        config.count,
+        &ElevationLevel::ALL,
+        &[1.0, 1.0, 1.0],
+    );
     let types = stratified(&mut rng, config.count, &TerrainType::ALL, &[0.6, 0.3, 0.1]);
-    let densities = stratified(&mut rng, config.count, &ObstacleDensity::ALL, &[1.0, 1.0, 1.0]);
-    levels.into_iter().zip(types).zip(densities).map(|((l, t), d)| (l, t, d)).collect()
+    let densities = stratified(
+        &mut rng,
+        config.count,
+        &ObstacleDensity::ALL,
+        &[1.0, 1.0, 1.0],
+    );
+    levels
+        .into_iter()
+        .zip(types)
+        .zip(densities)
+        .map(|((l, t), d)| (l, t, d))
+        .collect()
 }
 
 /// The 10 start/goal pairs on the task circle: start k at k·36°, goal opposite.
@@ -107,17 +134,28 @@ pub fn task_pairs(scale: f64) -> Vec<Task> {
         .map(|k| {
             let a = (f64::from(k) * 36.0).to_radians();
             let (s, c) = (libm::sin(a), libm::cos(a));
-            Task { pair: k, start: [r * c, r * s], goal: [-r * c, -r * s] }
+            Task {
+                pair: k,
+                start: [r * c, r * s],
+                goal: [-r * c, -r * s],
+            }
         })
         .collect()
 }
 
 /// Plans the global path of every task of a world.
-pub fn plan_paths(world_obstacles: &[crate::Obstacle], terrain: &Heightfield, tasks: &[Task], clearance: f64) -> Vec<GlobalPath> {
+pub fn plan_paths(
+    world_obstacles: &[crate::Obstacle],
+    terrain: &Heightfield,
+    tasks: &[Task],
+    clearance: f64,
+) -> Vec<GlobalPath> {
     let grid = PlanningGrid::new(terrain.size(), terrain.cell(), world_obstacles, clearance);
     tasks
         .iter()
-        .map(|t| GlobalPath { points: grid.plan(t.start, t.goal).unwrap_or_default() })
+        .map(|t| GlobalPath {
+            points: grid.plan(t.start, t.goal).unwrap_or_default(),
+        })
         .collect()
 }
 
@@ -134,12 +172,21 @@ pub fn generate_world(
     let cell = scale;
     let max_height = level.max_height() * scale;
     let seed = config.seed;
-    let fractions = source.generate(&mut Rng::derive(seed, "elevation", u64::from(index)), GRID_SIZE);
+    let fractions = source.generate(
+        &mut Rng::derive(seed, "elevation", u64::from(index)),
+        GRID_SIZE,
+    );
     // Heights are rounded to f32 here, the precision of the file format, so a world in memory
     // is bit-identical to the same world loaded back from disk.
-    let heights: Vec<f64> = fractions.iter().map(|f| f64::from((f * max_height) as f32)).collect();
+    let heights: Vec<f64> = fractions
+        .iter()
+        .map(|f| f64::from((f * max_height) as f32))
+        .collect();
     let terrain = Heightfield::new(GRID_SIZE, cell, heights);
-    let patches = semantics::generate_patches(&mut Rng::derive(seed, "semantics", u64::from(index)), terrain_type);
+    let patches = semantics::generate_patches(
+        &mut Rng::derive(seed, "semantics", u64::from(index)),
+        terrain_type,
+    );
     let tasks = task_pairs(scale);
     let keep_clear: Vec<[f64; 2]> = tasks.iter().flat_map(|t| [t.start, t.goal]).collect();
     let obstacles = obstacles::place_obstacles(
@@ -156,7 +203,10 @@ pub fn generate_world(
         meta: WorldMeta {
             name: format!("{}/{:03}", set_name(config), index),
             index,
-            source: WorldSource::Generated { set_seed: seed, generator: source.name().to_string() },
+            source: WorldSource::Generated {
+                set_seed: seed,
+                generator: source.name().to_string(),
+            },
             level,
             terrain_type,
             density,
@@ -175,9 +225,16 @@ pub fn generate_world(
 /// Conventional name of a generated set: `verti-100` for the default, otherwise
 /// `verti-{count}-s{seed}` with a scale suffix when not 1.
 pub fn set_name(config: &SetConfig) -> String {
-    let mut name = if config.seed == 0 { format!("verti-{}", config.count) } else { format!("verti-{}-s{}", config.count, config.seed) };
+    let mut name = if config.seed == 0 {
+        format!("verti-{}", config.count)
+    } else {
+        format!("verti-{}-s{}", config.count, config.seed)
+    };
     if (config.scale - 1.0).abs() > 1e-12 {
-        name.push_str(&format!("-x{}", crate::scale::scale_label(config.scale).replace('/', "_")));
+        name.push_str(&format!(
+            "-x{}",
+            crate::scale::scale_label(config.scale).replace('/', "_")
+        ));
     }
     name
 }
@@ -224,8 +281,29 @@ mod tests {
 
     #[test]
     fn bad_configs_are_rejected() {
-        assert!(SetConfig { count: 0, ..Default::default() }.validate().is_err());
-        assert!(SetConfig { scale: -1.0, ..Default::default() }.validate().is_err());
-        assert!(SetConfig { clearance: f64::NAN, ..Default::default() }.validate().is_err());
+        assert!(
+            SetConfig {
+                count: 0,
+                ..Default::default()
+            }
+            .validate()
+            .is_err()
+        );
+        assert!(
+            SetConfig {
+                scale: -1.0,
+                ..Default::default()
+            }
+            .validate()
+            .is_err()
+        );
+        assert!(
+            SetConfig {
+                clearance: f64::NAN,
+                ..Default::default()
+            }
+            .validate()
+            .is_err()
+        );
     }
 }

@@ -42,16 +42,31 @@ pub fn rock_faces(rng: &mut Rng, s: f64, world_scale: f64) -> Vec<Face> {
         let phi = golden * k as f64 + 0.3 * rng.normal();
         let n = Vec3::new(r * cos(phi), r * sin(phi), z).normalized();
         // support of the ellipsoid in direction n, pulled in by up to 12 %
-        let h = sqrt(a * a * n.x * n.x + b * b * n.y * n.y + c * c * n.z * n.z) * rng.range(0.88, 1.0);
-        faces.push(Face { normal: n, offset: h });
+        let h =
+            sqrt(a * a * n.x * n.x + b * b * n.y * n.y + c * c * n.z * n.z) * rng.range(0.88, 1.0);
+        faces.push(Face {
+            normal: n,
+            offset: h,
+        });
     }
-    faces.push(Face { normal: -Vec3::Z, offset: 0.6 * c });
+    faces.push(Face {
+        normal: -Vec3::Z,
+        offset: 0.6 * c,
+    });
     faces
 }
 
 /// Seats a rock: the position that puts its lowest vertex `bury` below the lowest ground under
 /// its footprint.
-fn seat_rock(terrain: &Heightfield, faces: Vec<Face>, s: f64, x: f64, y: f64, yaw: f64, world_scale: f64) -> Obstacle {
+fn seat_rock(
+    terrain: &Heightfield,
+    faces: Vec<Face>,
+    s: f64,
+    x: f64,
+    y: f64,
+    yaw: f64,
+    world_scale: f64,
+) -> Obstacle {
     let local = polytope_vertices(&faces);
     let reach = local.iter().map(|v| v.norm_xy()).fold(0.0, f64::max);
     let z_min_local = local.iter().map(|v| v.z).fold(f64::INFINITY, f64::min);
@@ -65,8 +80,12 @@ fn seat_tree(terrain: &Heightfield, x: f64, y: f64, world_scale: f64) -> Obstacl
     let h = TREE_HEIGHT * world_scale;
     let (ground, _) = terrain.range_in_box(x - r, y - r, x + r, y + r);
     let base = ground - TREE_BURY * world_scale;
-    Obstacle::tree(r, h + TREE_BURY * world_scale, Vec3::new(x, y, base + 0.5 * (h + TREE_BURY * world_scale)))
-        .expect("tree size is positive")
+    Obstacle::tree(
+        r,
+        h + TREE_BURY * world_scale,
+        Vec3::new(x, y, base + 0.5 * (h + TREE_BURY * world_scale)),
+    )
+    .expect("tree size is positive")
 }
 
 /// Places the obstacles of a density. `keep_clear` are the start and goal points.
@@ -93,7 +112,11 @@ pub fn place_obstacles(
             }
         }
         let p = placed.ok_or_else(|| {
-            format!("could not place obstacle {} of {} with {min_d} m separation", k + 1, rocks + trees)
+            format!(
+                "could not place obstacle {} of {} with {min_d} m separation",
+                k + 1,
+                rocks + trees
+            )
         })?;
         centres.push(p);
         if k < rocks {
@@ -114,16 +137,33 @@ mod tests {
 
     #[test]
     fn rocks_are_rock_sized_and_rest_on_the_ground() {
-        let terrain = Heightfield::new(129, 1.0, (0..129 * 129).map(|i| ((i % 129) as f64 * 0.05).sin()).collect());
+        let terrain = Heightfield::new(
+            129,
+            1.0,
+            (0..129 * 129)
+                .map(|i| ((i % 129) as f64 * 0.05).sin())
+                .collect(),
+        );
         let mut rng = Rng::new(1);
-        let obs = place_obstacles(&mut rng, &terrain, ObstacleDensity::Dense, &[[60.0, 0.0], [-60.0, 0.0]], 1.0).unwrap();
+        let obs = place_obstacles(
+            &mut rng,
+            &terrain,
+            ObstacleDensity::Dense,
+            &[[60.0, 0.0], [-60.0, 0.0]],
+            1.0,
+        )
+        .unwrap();
         assert_eq!(obs.len(), 43);
         assert_eq!(obs.iter().filter(|o| o.is_rock()).count(), 40);
         for o in &obs {
             let (z0, z1) = o.z_range();
             let p = o.position();
-            let (ground_lo, ground_hi) = terrain.range_in_box(p.x - 3.0, p.y - 3.0, p.x + 3.0, p.y + 3.0);
-            assert!(z0 < ground_lo + 1e-9, "obstacle floats: base {z0} above ground {ground_lo}");
+            let (ground_lo, ground_hi) =
+                terrain.range_in_box(p.x - 3.0, p.y - 3.0, p.x + 3.0, p.y + 3.0);
+            assert!(
+                z0 < ground_lo + 1e-9,
+                "obstacle floats: base {z0} above ground {ground_lo}"
+            );
             assert!(z1 > ground_hi, "obstacle is buried");
             if o.is_rock() {
                 let span = 2.0 * o.radius_xy();

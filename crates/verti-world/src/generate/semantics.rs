@@ -5,7 +5,9 @@
 //! Unlike the reference, nothing is converted afterwards: the soil a patch is labelled with is
 //! the soil that gets simulated there.
 
-use crate::surface::{FRICTION_RANGE, PATCHES_PER_SIDE, Patch, RIGID_RESTITUTION, Surface, TerrainClass};
+use crate::surface::{
+    FRICTION_RANGE, PATCHES_PER_SIDE, Patch, RIGID_RESTITUTION, Surface, TerrainClass,
+};
 use crate::world::TerrainType;
 use verti_core::Rng;
 
@@ -59,7 +61,9 @@ pub fn cluster_centres(rng: &mut Rng, k: usize) -> Vec<(usize, usize)> {
 pub fn sample_surface(rng: &mut Rng, class: TerrainClass) -> Surface {
     match (class.friction_distribution(), class.soil()) {
         (Some((mean, std)), _) => Surface::Rigid {
-            friction: rng.gauss(mean, std).clamp(FRICTION_RANGE.0, FRICTION_RANGE.1),
+            friction: rng
+                .gauss(mean, std)
+                .clamp(FRICTION_RANGE.0, FRICTION_RANGE.1),
             restitution: RIGID_RESTITUTION,
         },
         (None, Some(soil)) => Surface::Deformable { soil },
@@ -85,7 +89,10 @@ pub fn generate_patches(rng: &mut Rng, terrain_type: TerrainType) -> Vec<Patch> 
                 }
             }
             let class = classes[best];
-            patches.push(Patch { class, surface: sample_surface(rng, class) });
+            patches.push(Patch {
+                class,
+                surface: sample_surface(rng, class),
+            });
         }
     }
     patches
@@ -102,9 +109,15 @@ mod tests {
             let rigid = generate_patches(&mut rng, TerrainType::Rigid);
             assert!(rigid.iter().all(|p| !p.class.is_deformable()));
             let soil = generate_patches(&mut rng, TerrainType::Deformable);
-            assert!(soil.iter().all(|p| p.class.is_deformable() && p.surface.is_deformable()));
+            assert!(
+                soil.iter()
+                    .all(|p| p.class.is_deformable() && p.surface.is_deformable())
+            );
             let classes = cluster_classes(&mut rng, TerrainType::Mixed);
-            assert!(classes.iter().any(|c| c.is_deformable()) && classes.iter().any(|c| !c.is_deformable()));
+            assert!(
+                classes.iter().any(|c| c.is_deformable())
+                    && classes.iter().any(|c| !c.is_deformable())
+            );
             assert!((2..=10).contains(&classes.len()));
         }
     }
@@ -116,7 +129,10 @@ mod tests {
         let n = 20000;
         for _ in 0..n {
             match sample_surface(&mut rng, TerrainClass::Grass) {
-                Surface::Rigid { friction, restitution } => {
+                Surface::Rigid {
+                    friction,
+                    restitution,
+                } => {
                     assert!((0.1..=1.0).contains(&friction));
                     assert_eq!(restitution, 0.01);
                     sum += friction;
