@@ -687,9 +687,9 @@ mod tests {
             "a",
             ElevationLevel::Low,
             TerrainType::Rigid,
-            vec![0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8],
+            vec![0.02, 0.05, 0.08, 0.12, 0.18, 0.23, 0.26, 0.29, 0.35],
         );
-        let b = tiny("b", ElevationLevel::High, TerrainType::Mixed, vec![1.0; 9]);
+        let b = tiny("b", ElevationLevel::High, TerrainType::Mixed, vec![1.05; 9]);
         let s = set_stats(&[a, b]);
         assert_eq!(
             (s.worlds, s.tasks, s.scale, s.mixed_scales),
@@ -722,16 +722,17 @@ mod tests {
             }
         );
 
-        // Low: heights 0.0..0.8 in 0.25 m bins -> 0.0,0.1,0.2 | 0.3,0.4 | 0.5,0.6,0.7 | 0.8.
+        // Low: 0.1 m bins -> 0.02,0.05,0.08 | 0.12,0.18 | 0.23,0.26,0.29 | 0.35 (values kept off
+        // the bin edges, where floating-point division could go either way).
         let low = &s.elevation[0];
-        assert_eq!(low.counts.len(), 64);
+        assert_eq!(low.counts.len(), 160);
         assert_eq!(&low.counts[..4], &[3, 2, 3, 1]);
         assert!((low.frequency.iter().sum::<f64>() - 1.0).abs() < 1e-12);
-        assert!((low.mean.unwrap() - 0.4).abs() < 1e-12);
-        assert!((low.relief.unwrap().mean - 0.8).abs() < 1e-12);
-        // High: a flat world at 1 m, bin 4; no relief.
+        assert!((low.mean.unwrap() - 1.58 / 9.0).abs() < 1e-12);
+        assert!((low.relief.unwrap().mean - 0.33).abs() < 1e-12);
+        // High: a flat world at 1.05 m, bin 10; no relief.
         let high = &s.elevation[2];
-        assert_eq!(high.counts[4], 9);
+        assert_eq!(high.counts[10], 9);
         assert_eq!(high.relief.unwrap().max, 0.0);
         assert_eq!((high.ceiling, high.worlds), (16.0, 1));
         // Mid: no worlds, all empty but well-formed.
@@ -801,12 +802,14 @@ mod tests {
             "s",
             ElevationLevel::Mid,
             TerrainType::Rigid,
-            vec![0.0, 0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08],
+            vec![
+                0.002, 0.005, 0.008, 0.012, 0.018, 0.023, 0.026, 0.029, 0.035,
+            ],
         );
         w.meta.scale = 0.1;
         let s = set_stats(&[w]);
         let mid = &s.elevation[1];
-        assert!((mid.bin_width - 0.025).abs() < 1e-15 && (mid.ceiling - 0.96).abs() < 1e-12);
+        assert!((mid.bin_width - 0.01).abs() < 1e-15 && (mid.ceiling - 0.96).abs() < 1e-12);
         assert_eq!(&mid.counts[..4], &[3, 2, 3, 1]);
     }
 
