@@ -108,9 +108,12 @@ impl fmt::Display for BenchReport {
     }
 }
 
-/// The fixed scripted input of the benchmark: 60 % throttle and a slow weave.
-pub fn bench_controls(t: f64) -> Controls {
-    Controls { throttle: 0.6, brake: 0.0, steering: 0.4 * (0.3 * t).sin() }
+/// The fixed scripted input of the benchmark: Verti-Bench's speed controller (proportional,
+/// gain 1, throttle or brake) toward 4 m/s (scaled with √scale), and a slow left weave that
+/// keeps the vehicle circling near the map centre.
+pub fn bench_controls(t: f64, forward_speed: f64, scale: f64) -> Controls {
+    let u = (4.0 * scale.sqrt() - forward_speed).clamp(-1.0, 1.0);
+    Controls { throttle: u.max(0.0), brake: (-u).max(0.0), steering: 0.35 + 0.25 * (0.25 * t).sin() }
 }
 
 /// Drives each vehicle for `sim_seconds` on the rigid and the soil world of its scale with
@@ -155,7 +158,7 @@ pub fn bench(worlds: &BenchWorlds, vehicles: &[VehicleSpec], sim_seconds: f64, r
                 let start = state.com_position();
                 let t0 = Instant::now();
                 for _ in 0..n {
-                    let controls = bench_controls(state.time());
+                    let controls = bench_controls(state.time(), state.forward_speed(), world.meta.scale);
                     if let Err(e) = sim.step(&mut state, controls, control_dt) {
                         error = Some(e.to_string());
                         break;

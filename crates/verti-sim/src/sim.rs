@@ -24,7 +24,7 @@ use crate::error::SimError;
 use crate::powertrain::{RPM_TO_RAD_S, engine_torque, shift};
 use crate::soil::{SoilLayout, SoilState, bekker_pressure, bekker_slope};
 use crate::spec::{Differential, SteeringKind, VehicleSpec};
-use crate::terrain::{HeightBound, ObstacleGrid};
+use crate::terrain::{Ground, HeightBound, ObstacleGrid};
 use crate::tyre::{janosi_fraction, janosi_sliding_slip, tmeasy_combined, tmeasy_sliding_slip};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -371,6 +371,7 @@ pub struct Sim {
     friction_speed: f64,
     reach: f64,
     bound: HeightBound,
+    ground: Ground,
     obstacles: ObstacleGrid,
     soil: Option<SoilLayout>,
     driven_wheels: usize,
@@ -590,6 +591,7 @@ impl Sim {
         };
         let sim = Sim {
             bound: HeightBound::new(world),
+            ground: Ground::new(world),
             obstacles: ObstacleGrid::new(world, reach),
             world: Arc::clone(world),
             spec: spec.clone(),
@@ -767,7 +769,22 @@ impl Sim {
                 break;
             }
         }
+        // per-wheel steer angles are outputs only: computed once per call, not per internal step
+        let turn_radius = self.turn_radius(state.steer);
+        for (m, w) in self.wheels.iter().zip(state.wheels.iter_mut()) {
+            w.steer_angle = if m.steered && turn_radius.is_finite() { (m.ackermann_dx / (turn_radius - m.y)).atan() } else { 0.0 };
+        }
         state.check(self.world.meta.scale)
+    }
+
+    /// Turn radius of the rear-axle centre for a bicycle steer angle (infinite when straight
+    /// or skid-steered).
+    fn turn_radius(&self, steer: f64) -> f64 {
+        if self.spec.steering.kind == SteeringKind::Ackermann && steer.abs() > 1e-9 {
+            self.wheels_base_length() / steer.tan()
+        } else {
+            f64::INFINITY
+        }
     }
 
     /// One internal step.
@@ -789,7 +806,7 @@ impl Sim {
             let max_delta = spec.steering.rate_deg_per_s.to_radians() * h;
             st.steer += (target - st.steer).clamp(-max_delta, max_delta);
         }
-        let turn_radius = if !skid && st.steer.abs() > 1e-9 { self.wheels_base_length() / st.steer.tan() } else { f64::INFINITY };
+        let turn_radius = self.turn_radius(st.steer);
 
         // ---- powertrain ----
         let p = &spec.powertrain;
@@ -806,7 +823,7 @@ impl Sim {
         let we = engine_speed_of(st.gear);
         // Closed-throttle drag opposes the rotation (smoothly through zero) so coasting never
         // gains energy; the full-throttle part always drives forward.
-        let drag_sign = (mean_spin / ratio / 5.0).tanh();
+        let drag_sign = soft_sign(mean_spin / ratio / 5.0);
         let t_full = engine_torque(p, we, 1.0);
         let t_zero = engine_torque(p, we, 0.0);
         let te = t_full * ctl.throttle + t_zero * (1.0 - ctl.throttle) * drag_sign;
@@ -836,12 +853,15 @@ impl Sim {
         let mut slip_inputs = [(0.0, 0.0, 0.0, 0.0, 0.0); crate::spec::MAX_WHEELS]; // (vx, vy, radius, clamp, fz)
         for (w, m) in self.wheels.iter().enumerate() {
             let ws = st.wheels[w];
-            let delta = if m.steered && turn_radius.is_finite() {
-                (m.ackermann_dx / (turn_radius - m.y)).atan()
+            // Ackermann: the wheel points at the turn centre on the rear-axle line, so
+            // tan δ = dx / (R − y); sine and cosine follow without trigonometric calls.
+            let (sd, cd) = if m.steered && turn_radius.is_finite() {
+                let d = turn_radius - m.y;
+                let hyp = (m.ackermann_dx * m.ackermann_dx + d * d).sqrt();
+                (m.ackermann_dx * d.signum() / hyp, d.abs() / hyp)
             } else {
-                0.0
+                (0.0, 1.0)
             };
-            let (sd, cd) = delta.sin_cos();
             let axle = ex * (-sd) + ey * cd;
             let r = q.rotate(m.attach + Vec3::Z * ws.compression);
             let hub = st.position + r;
@@ -920,7 +940,7 @@ impl Sim {
                 lat_force = fy;
                 f_ext += e_long * fx + e_lat * fy;
                 let vroll = spin * radius;
-                roll_torque = -spec.tyre.rolling_resistance * contact.rigid_load * radius * (vroll / 0.1).tanh();
+                roll_torque = -spec.tyre.rolling_resistance * contact.rigid_load * radius * soft_sign(vroll / 0.1);
             }
             slip_inputs[w] = (vx, vy, radius, slip_clamp, fz_total);
 
@@ -943,7 +963,6 @@ impl Sim {
             wheel_c[w] = c_extra + contact.c_axis;
 
             let out = &mut st.wheels[w];
-            out.steer_angle = delta;
             out.normal_force = fz_total;
             out.long_force = long_force;
             out.lat_force = lat_force;
@@ -1057,7 +1076,7 @@ impl Sim {
         st.velocity += accel * h;
         st.omega += alpha_body * h;
         st.position += st.velocity * h;
-        st.orientation = st.orientation.integrate_world(q.rotate(st.omega), h);
+        st.orientation = integrate_orientation(st.orientation, q.rotate(st.omega), h);
         st.contacts = contacts;
     }
 
@@ -1082,6 +1101,8 @@ impl Sim {
     ) -> WheelContact {
         let world = &*self.world;
         let hf = &world.terrain;
+        let ground = &self.ground;
+        let patches = world.patches.patches();
         let tyre = &self.spec.tyre;
         let mut c = WheelContact::default();
         let r = m.radius;
@@ -1103,7 +1124,7 @@ impl Sim {
         if near_ground {
             // (1) disc-vs-plane lowest point under the hub, (2) four rim samples fore and aft so
             // steps and rock edges are seen before the hub reaches them.
-            let (_, gx, gy) = hf.sample(hub.x, hub.y);
+            let (_, gx, gy) = ground.sample(hub.x, hub.y);
             let n0 = Vec3::new(-gx, -gy, 1.0).normalized();
             let np = n0 - axle * n0.dot(axle);
             let npn = np.norm();
@@ -1124,12 +1145,14 @@ impl Sim {
                 if k > 0 && p.z >= self.bound.max_at(p.x, p.y) {
                     continue;
                 }
-                let (h, gx, gy) = hf.sample(p.x, p.y);
+                let (h, gx, gy) = ground.sample(p.x, p.y);
                 if h <= p.z {
                     continue;
                 }
-                let mu = match world.patches.at(p.x, p.y).surface {
+                let mu = match patches[ground.patch_index(p.x, p.y)].surface {
                     Surface::Rigid { friction, .. } => friction,
+                    // beyond the map edge there are no soil nodes: the ground acts rigid there
+                    Surface::Deformable { soil } if !hf.contains(p.x, p.y) => soil.friction_angle_deg.to_radians().tan(),
                     Surface::Deformable { .. } => {
                         soil_here = true;
                         continue;
@@ -1145,7 +1168,7 @@ impl Sim {
             }
             if !soil_here && self.soil.is_some() {
                 // the wheel may be sunk in soil with its rim samples above the undeformed level
-                soil_here = world.patches.at(hub.x, hub.y).surface.is_deformable();
+                soil_here = patches[ground.patch_index(hub.x, hub.y)].surface.is_deformable();
             }
         }
         let k_t = tyre.radial_stiffness;
@@ -1230,8 +1253,8 @@ impl Sim {
         up: Vec3,
         c: &mut WheelContact,
     ) {
-        let world = &*self.world;
-        let hf = &world.terrain;
+        let patches = self.world.patches.patches();
+        let ground = &self.ground;
         let r = m.radius;
         let delta = layout.delta;
         let area = delta * delta;
@@ -1245,10 +1268,10 @@ impl Sim {
         let fwd = Vec3::Z.cross(axle).normalized();
         let ext_x = half_chord * fwd.x.abs() + m.half_width * axle.x.abs() + 0.5 * delta;
         let ext_y = half_chord * fwd.y.abs() + m.half_width * axle.y.abs() + 0.5 * delta;
-        let i0 = ((hub.x - ext_x) / delta).ceil() as i64;
-        let i1 = ((hub.x + ext_x) / delta).floor() as i64;
-        let j0 = ((hub.y - ext_y) / delta).ceil() as i64;
-        let j1 = ((hub.y + ext_y) / delta).floor() as i64;
+        let i0 = fast_ceil((hub.x - ext_x) / delta);
+        let i1 = fast_floor((hub.x + ext_x) / delta);
+        let j0 = fast_ceil((hub.y - ext_y) / delta);
+        let j1 = fast_floor((hub.y + ext_y) / delta);
         if i1 < i0 || j1 < j0 || ((i1 - i0 + 1) * (j1 - j0 + 1)) as usize > MAX_SOIL_NODES_PER_WHEEL {
             return;
         }
@@ -1258,7 +1281,6 @@ impl Sim {
         if ee < 1e-6 {
             return; // wheel lying flat: the tread cannot meet a vertical ray
         }
-        let omega_vec = axle * spin;
         let mut along_min = f64::INFINITY;
         let mut along_max = f64::NEG_INFINITY;
         let mut across_min = f64::INFINITY;
@@ -1266,6 +1288,8 @@ impl Sim {
         let mut shear_limit = 0.0;
         let mut janosi_weighted = 0.0;
         let mut load = 0.0;
+        let mut cached_patch = usize::MAX;
+        let mut cached_soil: Option<(verti_world::SoilParams, f64)> = None;
         for j in j0..=j1 {
             let y = j as f64 * delta;
             for i in i0..=i1 {
@@ -1283,12 +1307,17 @@ impl Sim {
                 if lateral.abs() > m.half_width {
                     continue;
                 }
-                let soil = match world.patches.at(x, y).surface {
-                    Surface::Deformable { soil } => soil,
-                    Surface::Rigid { .. } => continue,
-                };
+                let pk = ground.patch_index(x, y);
+                if pk != cached_patch {
+                    cached_patch = pk;
+                    cached_soil = match patches[pk].surface {
+                        Surface::Deformable { soil } => Some((soil, soil.friction_angle_deg.to_radians().tan())),
+                        Surface::Rigid { .. } => None,
+                    };
+                }
+                let Some((soil, tan_phi)) = cached_soil else { continue };
                 let Some(at) = layout.locate(i, j) else { continue };
-                let (z0, gx, gy) = hf.sample(x, y);
+                let (z0, gx, gy) = ground.sample(x, y);
                 let ca = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
                 let sinkage = ca * (z0 - t);
                 let (plastic, yield_p) = st.soil.node(at);
@@ -1300,16 +1329,19 @@ impl Sim {
                 let mut slope = ke;
                 if sigma > yield_p {
                     sigma = bekker_pressure(&soil, b, sinkage);
-                    slope = bekker_slope(&soil, b, sinkage).min(ke);
+                    slope = bekker_slope(&soil, sigma, sinkage).min(ke);
                     let new_plastic = (sinkage - sigma / ke).max(plastic);
                     st.soil.set_node(at, new_plastic, sigma);
                 }
                 let normal = Vec3::new(-gx * ca, -gy * ca, ca);
                 let point = Vec3::new(x, y, t);
                 let arm = point - hub;
-                let v_point = v_hub + omega_vec.cross(arm);
-                // SCM damping acts on the normal speed (it may pull when the wheel lifts)
-                sigma -= v_point.dot(normal) * soil.damping;
+                // SCM damping on the normal speed of the wheel body. Chrono uses the speed of
+                // the contact point including the wheel's spin; a wheel spinning at high slip
+                // then sees its rotating tread as a fast plunge at the front of the patch and a
+                // lift at the rear (hundreds of kPa at R = 3e4), which is not soil physics.
+                // Deliberate fix: the hub's translation only. Like Chrono, it may pull.
+                sigma -= v_hub.dot(normal) * soil.damping;
                 let fnode = normal * (sigma * area);
                 c.force += fnode;
                 c.soil_moment += arm.cross(fnode);
@@ -1317,7 +1349,7 @@ impl Sim {
                 c.k_axis += slope * area * nu * nu;
                 c.c_axis += soil.damping * area * nu * nu;
                 let s_pos = sigma.max(0.0);
-                let tau_max = soil.cohesion + s_pos * soil.friction_angle_deg.to_radians().tan();
+                let tau_max = soil.cohesion + s_pos * tan_phi;
                 shear_limit += tau_max * area;
                 janosi_weighted += soil.janosi_k * sigma.abs() * area;
                 load += sigma * area;
@@ -1381,15 +1413,15 @@ impl Sim {
             true
         };
         if z0 < self.bound.max_in(x0, y0, x1, y1) {
-            let hf = &world.terrain;
+            let patches = world.patches.patches();
             for p in &pts {
-                let (h, gx, gy) = hf.sample(p.x, p.y);
+                let (h, gx, gy) = self.ground.sample(p.x, p.y);
                 if h <= p.z {
                     continue;
                 }
                 let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
                 let n = Vec3::new(-gx * nz, -gy * nz, nz);
-                let mu = match world.patches.at(p.x, p.y).surface {
+                let mu = match patches[self.ground.patch_index(p.x, p.y)].surface {
                     Surface::Rigid { friction, .. } => friction.min(mu_body),
                     Surface::Deformable { soil } => soil.friction_angle_deg.to_radians().tan().min(mu_body),
                 };
@@ -1441,6 +1473,35 @@ impl Sim {
             }
         }
     }
+}
+
+/// x / sqrt(1 + x²): a smooth sign without a transcendental call.
+#[inline]
+fn soft_sign(x: f64) -> f64 {
+    x / (1.0 + x * x).sqrt()
+}
+
+/// floor for finite values of moderate size, without the library call.
+#[inline]
+fn fast_floor(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x { t - 1 } else { t }
+}
+
+#[inline]
+fn fast_ceil(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) < x { t + 1 } else { t }
+}
+
+/// First-order quaternion update by a world-frame angular velocity, renormalised. With
+/// |ω|·h below 0.1 rad per step its error is far below the model's; it avoids the sin/cos
+/// of the exact exponential map on every step.
+#[inline]
+fn integrate_orientation(q: Quat, omega: Vec3, h: f64) -> Quat {
+    let k = 0.5 * h;
+    let dq = Quat { w: 0.0, x: omega.x * k, y: omega.y * k, z: omega.z * k }.mul(q);
+    Quat { w: q.w + dq.w, x: q.x + dq.x, y: q.y + dq.y, z: q.z + dq.z }.normalized()
 }
 
 /// Key identifying which spin group a wheel joins (None = its own group).

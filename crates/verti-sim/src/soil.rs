@@ -125,11 +125,11 @@ pub fn bekker_pressure(soil: &verti_world::SoilParams, b: f64, z: f64) -> f64 {
     (soil.bekker_kc / b + soil.bekker_kphi) * z.max(0.0).powf(soil.bekker_n)
 }
 
-/// Derivative of the Bekker pressure with respect to sinkage [Pa/m].
+/// Derivative of the Bekker pressure with respect to sinkage [Pa/m], from the pressure
+/// `sigma` already computed at sinkage `z` (n·σ/z, no second `powf`).
 #[inline]
-pub fn bekker_slope(soil: &verti_world::SoilParams, b: f64, z: f64) -> f64 {
-    let z = z.max(1e-4);
-    (soil.bekker_kc / b + soil.bekker_kphi) * soil.bekker_n * z.powf(soil.bekker_n - 1.0)
+pub fn bekker_slope(soil: &verti_world::SoilParams, sigma: f64, z: f64) -> f64 {
+    soil.bekker_n * sigma / z.max(1e-4)
 }
 
 #[cfg(test)]

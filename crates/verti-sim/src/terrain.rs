@@ -42,8 +42,9 @@ impl HeightBound {
     #[inline]
     fn block_of(&self, x: f64, y: f64) -> (usize, usize) {
         let m = (self.blocks - 1) as f64;
-        let col = ((x + self.half_extent) / self.block_size).floor().clamp(0.0, m) as usize;
-        let row = ((self.half_extent - y) / self.block_size).floor().clamp(0.0, m) as usize;
+        // clamp first, then truncate: equals floor for the non-negative values left
+        let col = ((x + self.half_extent) / self.block_size).clamp(0.0, m) as usize;
+        let row = ((self.half_extent - y) / self.block_size).clamp(0.0, m) as usize;
         (row, col)
     }
 
@@ -130,5 +131,93 @@ impl ObstacleGrid {
         }
         let k = r * self.cells + c;
         &self.items[self.starts[k] as usize..self.starts[k + 1] as usize]
+    }
+}
+
+/// A copy of the heightfield's triangle sampling tuned for the inner loops of the engine.
+///
+/// Same surface as [`verti_world::Heightfield::sample`] (cells split along the south-west to
+/// north-east diagonal, off-map points read the edge), but the cell index comes from a
+/// truncating cast of an already clamped, non-negative coordinate: on the baseline x86-64
+/// target `f64::floor` is a library call, and it was the largest single cost in the profile.
+#[derive(Clone, Debug)]
+pub struct Ground {
+    n: usize,
+    inv_cell: f64,
+    half: f64,
+    max_index: f64,
+    heights: Vec<f64>,
+    /// Patch grid lookup: patches per side, 1 / patch size, half extent of the patch grid.
+    patch_inv: f64,
+    patch_half: f64,
+}
+
+impl Ground {
+    pub fn new(world: &World) -> Ground {
+        let hf = &world.terrain;
+        let n = hf.size();
+        Ground {
+            n,
+            inv_cell: 1.0 / hf.cell(),
+            half: 0.5 * (n - 1) as f64,
+            max_index: (n - 1) as f64,
+            heights: hf.heights().to_vec(),
+            patch_inv: 1.0 / world.patches.patch_size(),
+            patch_half: 0.5 * verti_world::surface::PATCHES_PER_SIDE as f64 * world.patches.patch_size(),
+        }
+    }
+
+    /// Height and slopes (dz/dx, dz/dy) at (x, y).
+    #[inline]
+    pub fn sample(&self, x: f64, y: f64) -> (f64, f64, f64) {
+        let gc = (x * self.inv_cell + self.half).clamp(0.0, self.max_index);
+        let gr = (self.half - y * self.inv_cell).clamp(0.0, self.max_index);
+        let c0 = (gc as usize).min(self.n - 2);
+        let r0 = (gr as usize).min(self.n - 2);
+        let u = gc - c0 as f64;
+        let v = 1.0 - (gr - r0 as f64);
+        let base = r0 * self.n + c0;
+        let nw = self.heights[base];
+        let ne = self.heights[base + 1];
+        let sw = self.heights[base + self.n];
+        let se = self.heights[base + self.n + 1];
+        if u >= v {
+            let dx = se - sw;
+            let dy = ne - se;
+            (sw + u * dx + v * dy, dx * self.inv_cell, dy * self.inv_cell)
+        } else {
+            let dy = nw - sw;
+            let dx = ne - nw;
+            (sw + v * dy + u * dx, dx * self.inv_cell, dy * self.inv_cell)
+        }
+    }
+
+    /// Index into `PatchGrid::patches()` of the patch under (x, y) (edge patch off the map).
+    #[inline]
+    pub fn patch_index(&self, x: f64, y: f64) -> usize {
+        let m = (verti_world::surface::PATCHES_PER_SIDE - 1) as f64;
+        let col = ((x + self.patch_half) * self.patch_inv).clamp(0.0, m) as usize;
+        let row = ((self.patch_half - y) * self.patch_inv).clamp(0.0, m) as usize;
+        row * verti_world::surface::PATCHES_PER_SIDE + col
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ground_matches_heightfield() {
+        let w = crate::testing::rough_world(1.0, 3, 16.0, crate::testing::RoughSurface::Mixed);
+        let g = Ground::new(&w);
+        let mut rng = verti_core::Rng::new(5);
+        for _ in 0..2000 {
+            let (x, y) = (rng.range(-70.0, 70.0), rng.range(-70.0, 70.0));
+            let a = g.sample(x, y);
+            let b = w.terrain.sample(x, y);
+            assert!((a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9 && (a.2 - b.2).abs() < 1e-9);
+            let (r, c) = w.patches.index_at(x, y);
+            assert_eq!(g.patch_index(x, y), r * 16 + c);
+        }
     }
 }

@@ -1,0 +1,20 @@
+//! Speed benchmark: `cargo run -p verti-sim --release --example bench -- [SECONDS] [RUNS] [VEHICLE...]`
+//! (the CLI's `verti sim bench` calls the same `verti_sim::bench`).
+use verti_sim::{BenchWorlds, bench, vehicles};
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let seconds: f64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(60.0);
+    let runs: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(3);
+    let specs = if args.len() > 3 {
+        args[3..].iter().map(|n| vehicles::builtin(n).unwrap()).collect()
+    } else {
+        vehicles::all_builtin()
+    };
+    let worlds = BenchWorlds::synthetic_for(&specs);
+    let report = bench(&worlds, &specs, seconds, runs);
+    print!("{report}");
+    if std::env::var("JSON").is_ok() {
+        println!("{}", serde_json::to_string_pretty(&report).unwrap());
+    }
+}
