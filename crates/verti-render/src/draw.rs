@@ -5,6 +5,7 @@
 //! anything a valid world produces (points off the map included) without checks.
 
 use crate::RenderError;
+use crate::glyphs;
 use image::{ImageFormat, Rgb, RgbImage};
 use plotters::backend::{BitMapBackend, RGBPixel};
 use plotters::prelude::*;
@@ -149,7 +150,7 @@ pub(crate) fn polyline(img: &mut RgbImage, pts: &[(f64, f64)], colors: &[Rgb<u8>
         .copied()
         .filter(|p| p.0.is_finite() && p.1.is_finite())
         .collect();
-    if pts.is_empty() || colors.is_empty() || !(width > 0.0) {
+    if pts.is_empty() || colors.is_empty() || width.is_nan() || width <= 0.0 {
         return;
     }
     let h = 0.5 * width + 1.0;
@@ -217,16 +218,30 @@ impl Anchor {
     pub const CENTER: Anchor = Anchor(HPos::Center, VPos::Center);
 }
 
+/// Pixel advance of every character of `s` and the left bearing of its glyph at font size
+/// `size`, from the font's own metrics (see `glyphs`).
+fn layout(s: &str, size: f64) -> Result<Vec<(char, f64, f64)>, RenderError> {
+    let m = glyphs::metrics(DEJAVU_SANS)
+        .ok_or_else(|| RenderError::Draw("the vendored font has no usable metrics".into()))?;
+    let k = size / m.height;
+    Ok(s.chars()
+        .map(|c| {
+            let g = m.glyph(c);
+            (c, g.advance * k, g.lsb * k)
+        })
+        .collect())
+}
+
 /// Size (width, height) in pixels of `s` at font size `size`.
 pub(crate) fn text_size(s: &str, size: f64) -> Result<(u32, u32), RenderError> {
     ensure_font()?;
-    (FONT, size)
-        .into_font()
-        .box_size(s)
-        .map_err(|e| RenderError::Draw(format!("{e:?}")))
+    let w: f64 = layout(s, size)?.iter().map(|g| g.1).sum();
+    // Same line height as plotters' layout estimate.
+    Ok((w.ceil() as u32, (size / 1.24) as u32))
 }
 
-/// Draws `s` anchored at (x, y).
+/// Draws `s` anchored at (x, y): glyph by glyph, each at its pen position plus its left side
+/// bearing (which `plotters` would drop).
 pub(crate) fn text(
     img: &mut RgbImage,
     s: &str,
@@ -240,6 +255,13 @@ pub(crate) fn text(
     if !(x.is_finite() && y.is_finite()) {
         return Ok(());
     }
+    let glyphs = layout(s, size)?;
+    let width: f64 = glyphs.iter().map(|g| g.1).sum();
+    let mut pen = match anchor.0 {
+        HPos::Left => x,
+        HPos::Center => x - 0.5 * width,
+        HPos::Right => x - width,
+    };
     let (w, h) = img.dimensions();
     let backend = BitMapBackend::<RGBPixel>::with_buffer_and_format(img.as_mut(), (w, h))
         .map_err(|e| RenderError::Draw(e.to_string()))?;
@@ -247,13 +269,19 @@ pub(crate) fn text(
     let color = RGBColor(c[0], c[1], c[2]);
     let style = TextStyle::from((FONT, size).into_font())
         .color(&color)
-        .pos(Pos::new(anchor.0, anchor.1));
-    let at = (
-        x.round().clamp(-1e6, 1e6) as i32,
-        y.round().clamp(-1e6, 1e6) as i32,
-    );
-    root.draw(&Text::new(s.to_string(), at, style))
-        .map_err(|e| RenderError::Draw(e.to_string()))?;
+        .pos(Pos::new(HPos::Left, anchor.1));
+    let mut buf = [0u8; 4];
+    for (ch, advance, lsb) in glyphs {
+        if !ch.is_whitespace() {
+            let at = (
+                (pen + lsb.floor()).round().clamp(-1e6, 1e6) as i32,
+                y.round().clamp(-1e6, 1e6) as i32,
+            );
+            root.draw(&Text::new(&*ch.encode_utf8(&mut buf), at, style.clone()))
+                .map_err(|e| RenderError::Draw(e.to_string()))?;
+        }
+        pen += advance;
+    }
     root.present().map_err(|e| RenderError::Draw(e.to_string()))
 }
 

@@ -15,6 +15,7 @@
 //! depend on the fonts of the machine.
 
 mod draw;
+mod glyphs;
 mod histogram;
 mod map;
 pub mod palette;

@@ -666,14 +666,20 @@ pub fn render_world(world: &World, options: &RenderOptions) -> Result<WorldImage
 
     let path_width = (0.5 * ppc).max(1.6);
     if o.show_paths {
-        for (t, p) in world.tasks.iter().zip(&world.paths) {
-            if selected(t.pair) && !p.points.is_empty() {
-                let px: Vec<(f64, f64)> =
-                    p.points.iter().map(|q| map.to_pixel(q[0], q[1])).collect();
-                // A light casing keeps the red visible on red-brown terrain.
-                polyline(&mut img, &px, &[palette::WHITE], path_width + 1.5);
-                polyline(&mut img, &px, &[palette::PATH], path_width);
-            }
+        let lines: Vec<Vec<(f64, f64)>> = world
+            .tasks
+            .iter()
+            .zip(&world.paths)
+            .filter(|(t, p)| selected(t.pair) && !p.points.is_empty())
+            .map(|(_, p)| p.points.iter().map(|q| map.to_pixel(q[0], q[1])).collect())
+            .collect();
+        // A light casing keeps the red visible on red-brown terrain; all casings go first so
+        // none cuts across another path's red line.
+        for px in &lines {
+            polyline(&mut img, px, &[palette::WHITE], path_width + 1.5);
+        }
+        for px in &lines {
+            polyline(&mut img, px, &[palette::PATH], path_width);
         }
     }
 
