@@ -473,17 +473,16 @@ impl fmt::Display for SetStats {
             ("terrain type", &c.by_terrain_type),
             ("density", &c.by_density),
         ] {
-            write!(f, "  {title:<13}")?;
-            for r in rows {
-                write!(
-                    f,
-                    " {:>10} {:>3} ({:>4})",
-                    r.name,
-                    r.count,
-                    percent(r.count, self.worlds)
-                )?;
-            }
-            writeln!(f)?;
+            let cells: Vec<String> = rows
+                .iter()
+                .map(|r| {
+                    format!(
+                        "{:<20}",
+                        format!("{} {} ({})", r.name, r.count, percent(r.count, self.worlds))
+                    )
+                })
+                .collect();
+            writeln!(f, "  {title:<13} {}", cells.join(" ").trim_end())?;
         }
         writeln!(
             f,
