@@ -70,6 +70,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Default::default()
     };
     render_world(worlds.last().unwrap(), &big)?.save_png(&out.join("big_ppc8.png"))?;
+    // Original Verti-Bench worlds, when a folder of them is given as the second argument.
+    if let Some(vb) = std::env::args().nth(2) {
+        use verti_world::import_vb::{ImportOptions, import_vb, scan_vb_dir};
+        let mut vb_worlds = Vec::new();
+        for f in scan_vb_dir(std::path::Path::new(&vb))? {
+            vb_worlds.push(import_vb(
+                &f.config,
+                &f.heightmap,
+                f.labels.as_deref(),
+                &ImportOptions::default(),
+            )?);
+        }
+        let vb_stats = set_stats(&vb_worlds);
+        println!("\nVerti-Bench worlds\n{vb_stats}");
+        elevation_histograms_png(&vb_stats, &out.join("vb_elevation_histograms.png"))?;
+        for w in vb_worlds.iter().take(3) {
+            let name = format!(
+                "vb_{:03}_{}_{}.png",
+                w.meta.index, w.meta.level, w.meta.density
+            );
+            render_world(w, &RenderOptions::default())?.save_png(&out.join(name))?;
+        }
+    }
     println!("wrote {}", out.display());
     Ok(())
 }
