@@ -1,11 +1,11 @@
 //! Elevation histograms of a set, one panel per elevation level (the paper's Fig. 2 bottom).
 
 use crate::RenderError;
-use crate::draw::{FONT, ensure_font, save_png};
+use crate::draw::{Anchor, FONT, ensure_font, save_png, text};
 use image::RgbImage;
 use plotters::backend::{BitMapBackend, RGBPixel};
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::text_anchor::{HPos, VPos};
 use std::path::Path;
 use verti_world::stats::{LevelElevation, SetStats};
 
@@ -58,22 +58,33 @@ fn panel<DB: DrawingBackend>(
     e: &LevelElevation,
     xmax: f64,
     color: RGBColor,
-) -> Result<(), RenderError>
+) -> Result<Vec<Note>, RenderError>
 where
     DB::ErrorType: 'static,
 {
+    let mut notes = Vec::new();
     let title = format!(
         "{} elevation  ({} world{})",
         capitalise(&e.level),
         e.worlds,
         if e.worlds == 1 { "" } else { "s" }
     );
+    let (ax, ay) = area.get_base_pixel();
+    let (aw, _) = area.dim_in_pixel();
+    notes.push(Note {
+        text: title,
+        x: f64::from(ax) + 0.5 * f64::from(aw),
+        y: f64::from(ay) + 22.0,
+        size: 17.0,
+        anchor: Anchor::CENTER,
+    });
     let fmax = e.frequency.iter().copied().fold(0.0, f64::max);
     // Headroom above the tallest bar for the mean/relief note.
     let ymax = if fmax > 0.0 { fmax * 1.3 } else { 1.0 };
     let mut chart = ChartBuilder::on(area)
-        .caption(title, (FONT, 17))
         .margin(12)
+        .margin_top(40)
+        .margin_right(22)
         .x_label_area_size(38)
         .y_label_area_size(52)
         .build_cartesian_2d(0.0..xmax, 0.0..ymax)
@@ -93,17 +104,15 @@ where
         .draw()
         .map_err(draw_err)?;
     if e.worlds == 0 {
-        let style = TextStyle::from((FONT, 15).into_font())
-            .color(&RGBColor(0x70, 0x70, 0x70))
-            .pos(Pos::new(HPos::Center, VPos::Center));
-        chart
-            .draw_series(std::iter::once(Text::new(
-                "no worlds".to_string(),
-                (0.5 * xmax, 0.5 * ymax),
-                style,
-            )))
-            .map_err(draw_err)?;
-        return Ok(());
+        let (x, y) = chart.backend_coord(&(0.5 * xmax, 0.5 * ymax));
+        notes.push(Note {
+            text: "no worlds".into(),
+            x: f64::from(x),
+            y: f64::from(y),
+            size: 15.0,
+            anchor: Anchor::CENTER,
+        });
+        return Ok(notes);
     }
     let bars = e
         .frequency
@@ -144,20 +153,27 @@ where
                 r.mean, r.min, r.max
             ));
         }
-        let style = TextStyle::from((FONT, 12).into_font())
-            .color(&RGBColor(0x20, 0x20, 0x20))
-            .pos(Pos::new(HPos::Right, VPos::Top));
+        let (x, y) = chart.backend_coord(&(xmax, ymax));
         for (k, l) in lines.into_iter().enumerate() {
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    l,
-                    (xmax * 0.98, ymax * (0.98 - 0.07 * k as f64)),
-                    style.clone(),
-                )))
-                .map_err(draw_err)?;
+            notes.push(Note {
+                text: l,
+                x: f64::from(x) - 6.0,
+                y: f64::from(y) + 10.0 + 16.0 * k as f64,
+                size: 12.5,
+                anchor: Anchor(HPos::Right, VPos::Center),
+            });
         }
     }
-    Ok(())
+    Ok(notes)
+}
+
+/// A text drawn after the chart, with verti's own glyph layout (see `glyphs`).
+struct Note {
+    text: String,
+    x: f64,
+    y: f64,
+    size: f64,
+    anchor: Anchor,
 }
 
 fn capitalise(s: &str) -> String {
@@ -173,6 +189,7 @@ pub fn elevation_histograms_image(stats: &SetStats) -> Result<RgbImage, RenderEr
     let panels = stats.elevation.len().max(1) as u32;
     let (w, h) = (PANEL_W * panels, PANEL_H);
     let mut img = RgbImage::from_pixel(w, h, image::Rgb([255, 255, 255]));
+    let mut notes = Vec::new();
     {
         let backend = BitMapBackend::<RGBPixel>::with_buffer_and_format(img.as_mut(), (w, h))
             .map_err(draw_err)?;
@@ -180,9 +197,20 @@ pub fn elevation_histograms_image(stats: &SetStats) -> Result<RgbImage, RenderEr
         let areas = root.split_evenly((1, panels as usize));
         let xmax = x_max(stats);
         for (k, (area, e)) in areas.iter().zip(&stats.elevation).enumerate() {
-            panel(area, e, xmax, LEVEL_COLORS[k % LEVEL_COLORS.len()])?;
+            notes.extend(panel(area, e, xmax, LEVEL_COLORS[k % LEVEL_COLORS.len()])?);
         }
         root.present().map_err(draw_err)?;
+    }
+    for n in notes {
+        text(
+            &mut img,
+            &n.text,
+            n.x,
+            n.y,
+            n.size,
+            image::Rgb([0x20, 0x20, 0x20]),
+            n.anchor,
+        )?;
     }
     Ok(img)
 }

@@ -708,10 +708,16 @@ pub fn render_world(world: &World, options: &RenderOptions) -> Result<WorldImage
     if o.show_title {
         let m = &world.meta;
         let relief = hf.max_height() - hf.min_height();
-        let title = format!(
+        let mut title = format!(
             "{}   ·   {} elevation, {}, {} obstacles   ·   relief {:.1} m",
             m.name, m.level, m.terrain_type, m.density, relief
         );
+        if (m.scale - 1.0).abs() > 1e-9 {
+            title.push_str(&format!(
+                "   ·   scale {}",
+                verti_world::scale::scale_label(m.scale)
+            ));
+        }
         let avail = width - 2.0 * MARGIN;
         let mut fs = TITLE_FONT;
         while fs > 7.0 && f64::from(text_size(&title, fs)?.0) > avail {
