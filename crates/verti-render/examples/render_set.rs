@@ -70,6 +70,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Default::default()
     };
     render_world(worlds.last().unwrap(), &big)?.save_png(&out.join("big_ppc8.png"))?;
+    // A 1/6-scale world: metres shrink, pixels per cell do not.
+    let sixth = generate_set(
+        &SetConfig {
+            count: 1,
+            scale: 1.0 / 6.0,
+            ..Default::default()
+        },
+        &|| {},
+    )?;
+    render_world(&sixth[0], &RenderOptions::default())?.save_png(&out.join("scale_sixth.png"))?;
     // Original Verti-Bench worlds, when a folder of them is given as the second argument.
     if let Some(vb) = std::env::args().nth(2) {
         use verti_world::import_vb::{ImportOptions, import_vb, scan_vb_dir};

@@ -709,8 +709,14 @@ pub fn render_world(world: &World, options: &RenderOptions) -> Result<WorldImage
         let m = &world.meta;
         let relief = hf.max_height() - hf.min_height();
         let mut title = format!(
-            "{}   ·   {} elevation, {}, {} obstacles   ·   relief {:.1} m",
-            m.name, m.level, m.terrain_type, m.density, relief
+            "{}   ·   {} elevation, {}, {} obstacles   ·   relief {:.*} m",
+            m.name,
+            m.level,
+            m.terrain_type,
+            m.density,
+            // small-scale worlds have centimetre reliefs
+            if relief < 1.0 { 2 } else { 1 },
+            relief
         );
         if (m.scale - 1.0).abs() > 1e-9 {
             title.push_str(&format!(
