@@ -111,6 +111,8 @@ pub struct WheelState {
     pub touches_obstacle: bool,
     /// Deepest soil sinkage under the wheel [m].
     pub sinkage: f64,
+    /// Radial tyre deflection on rigid ground or obstacles [m].
+    pub tyre_deflection: f64,
 }
 
 /// Contact summary of the last internal step.
@@ -738,9 +740,10 @@ impl Sim {
             if w.compression < -m.rebound {
                 e += 0.5 * m.stop * (w.compression + m.rebound).powi(2);
             }
-            if w.normal_force > 0.0 && !w.on_soil {
-                // tyre spring energy from the static deflection F²/(2k)
-                e += 0.5 * w.normal_force * w.normal_force / self.spec.tyre.radial_stiffness;
+            let d = w.tyre_deflection;
+            e += 0.5 * self.spec.tyre.radial_stiffness * d * d;
+            if d > m.rim_depth {
+                e += 0.5 * 10.0 * self.spec.tyre.radial_stiffness * (d - m.rim_depth).powi(2);
             }
         }
         for (g, grp) in self.groups.iter().enumerate() {
@@ -867,7 +870,7 @@ impl Sim {
             let hub = st.position + r;
             let v_hub = st.velocity + omega_w.cross(r) + up * ws.compression_rate;
             let spin = st.group_spin[m.group];
-            let contact = self.wheel_contact(st, m, ws.soil_patch_b, hub, axle, v_hub, spin, up, near);
+            let contact = self.wheel_contact(st, m, ws.soil_patch_b, hub, axle, v_hub, up, near);
 
             // suspension force (pushes chassis up, wheel down)
             let mut f_susp = m.spring * ws.compression + m.damper * ws.compression_rate;
@@ -970,6 +973,7 @@ impl Sim {
             out.on_soil = contact.soil_nodes > 0;
             out.touches_obstacle = contact.obstacle;
             out.sinkage = contact.sinkage;
+            out.tyre_deflection = contact.depth;
             if contact.soil_nodes > 0 {
                 out.soil_patch_b = contact.soil_b;
             }
@@ -1087,6 +1091,7 @@ impl Sim {
 
     /// Contact of one wheel with rigid terrain, obstacles and soil.
     #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
     fn wheel_contact(
         &self,
         st: &mut SimState,
@@ -1095,7 +1100,6 @@ impl Sim {
         hub: Vec3,
         axle: Vec3,
         v_hub: Vec3,
-        spin: f64,
         up: Vec3,
         near: &[u32],
     ) -> WheelContact {
@@ -1232,7 +1236,7 @@ impl Sim {
         }
 
         if soil_here && let Some(layout) = self.soil {
-            self.soil_contact(st, &layout, m, soil_b, hub, axle, v_hub, spin, up, &mut c);
+            self.soil_contact(st, &layout, m, soil_b, hub, axle, v_hub, up, &mut c);
         }
         c
     }
@@ -1240,6 +1244,7 @@ impl Sim {
     /// SCM under one wheel: visits the nodes under the lower part of the wheel, updates their
     /// plastic memory and sums the pressure forces and their moment about the hub.
     #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
     fn soil_contact(
         &self,
         st: &mut SimState,
@@ -1249,7 +1254,6 @@ impl Sim {
         hub: Vec3,
         axle: Vec3,
         v_hub: Vec3,
-        spin: f64,
         up: Vec3,
         c: &mut WheelContact,
     ) {
@@ -1379,16 +1383,18 @@ impl Sim {
 
     /// Chassis collision box against terrain (rigid, or the undeformed soil surface) and
     /// obstacles: compliant normal force plus regularised Coulomb friction.
+    #[inline(never)]
     fn body_contacts(&self, st: &SimState, near: &[u32], force: &mut Vec3, torque: &mut Vec3, contacts: &mut ContactInfo) {
         let world = &*self.world;
         let q = st.orientation;
         let omega_w = q.rotate(st.omega);
         let mu_body = self.spec.chassis.friction;
+        let rm = q.to_mat3();
         let mut pts = [Vec3::ZERO; 18];
         let (mut x0, mut y0, mut z0) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
         let (mut x1, mut y1) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
         for (k, p) in self.body_points.iter().enumerate() {
-            let w = st.position + q.rotate(*p);
+            let w = st.position + rm.mul_vec(*p);
             pts[k] = w;
             x0 = x0.min(w.x);
             y0 = y0.min(w.y);
@@ -1415,6 +1421,9 @@ impl Sim {
         if z0 < self.bound.max_in(x0, y0, x1, y1) {
             let patches = world.patches.patches();
             for p in &pts {
+                if p.z >= self.bound.max_at(p.x, p.y) {
+                    continue;
+                }
                 let (h, gx, gy) = self.ground.sample(p.x, p.y);
                 if h <= p.z {
                     continue;
@@ -1440,6 +1449,12 @@ impl Sim {
             }
             let (oz0, oz1) = o.z_range();
             if st.position.z - self.reach > oz1 || st.position.z + self.reach < oz0 {
+                continue;
+            }
+            // The face-plane distance of the box centre bounds every box point's distance
+            // from below, so one query rules out most nearby obstacles.
+            let box_world = st.position + q.rotate(self.box_center);
+            if o.signed_distance(box_world).0 > self.box_half.norm() {
                 continue;
             }
             // chassis points inside the obstacle

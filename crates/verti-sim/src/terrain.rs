@@ -5,14 +5,14 @@
 use verti_world::World;
 
 /// Heightfield cells per side of one bound block.
-const BLOCK_CELLS: usize = 4;
+const BLOCK_CELLS: usize = 2;
 
-/// Maximum terrain height per block of 4x4 heightfield cells.
+/// Maximum terrain height per block of 2x2 heightfield cells.
 #[derive(Clone, Debug)]
 pub struct HeightBound {
     blocks: usize,
-    /// World size of one block [m].
-    block_size: f64,
+    /// 1 / world size of one block [1/m].
+    inv_block: f64,
     half_extent: f64,
     max: Vec<f64>,
 }
@@ -34,7 +34,7 @@ impl HeightBound {
                 max[br * blocks + bc] = m;
             }
         }
-        HeightBound { blocks, block_size: BLOCK_CELLS as f64 * hf.cell(), half_extent: hf.half_extent(), max }
+        HeightBound { blocks, inv_block: 1.0 / (BLOCK_CELLS as f64 * hf.cell()), half_extent: hf.half_extent(), max }
     }
 
     /// Block (row, col) of a world point, clamped to the map (off-map points read the edge,
@@ -43,8 +43,8 @@ impl HeightBound {
     fn block_of(&self, x: f64, y: f64) -> (usize, usize) {
         let m = (self.blocks - 1) as f64;
         // clamp first, then truncate: equals floor for the non-negative values left
-        let col = ((x + self.half_extent) / self.block_size).clamp(0.0, m) as usize;
-        let row = ((self.half_extent - y) / self.block_size).clamp(0.0, m) as usize;
+        let col = ((x + self.half_extent) * self.inv_block).max(0.0).min(m) as usize;
+        let row = ((self.half_extent - y) * self.inv_block).max(0.0).min(m) as usize;
         (row, col)
     }
 
@@ -170,8 +170,9 @@ impl Ground {
     /// Height and slopes (dz/dx, dz/dy) at (x, y).
     #[inline]
     pub fn sample(&self, x: f64, y: f64) -> (f64, f64, f64) {
-        let gc = (x * self.inv_cell + self.half).clamp(0.0, self.max_index);
-        let gr = (self.half - y * self.inv_cell).clamp(0.0, self.max_index);
+        // max/min compile to single instructions (a NaN coordinate reads cell 0, never panics)
+        let gc = (x * self.inv_cell + self.half).max(0.0).min(self.max_index);
+        let gr = (self.half - y * self.inv_cell).max(0.0).min(self.max_index);
         let c0 = (gc as usize).min(self.n - 2);
         let r0 = (gr as usize).min(self.n - 2);
         let u = gc - c0 as f64;
@@ -196,8 +197,8 @@ impl Ground {
     #[inline]
     pub fn patch_index(&self, x: f64, y: f64) -> usize {
         let m = (verti_world::surface::PATCHES_PER_SIDE - 1) as f64;
-        let col = ((x + self.patch_half) * self.patch_inv).clamp(0.0, m) as usize;
-        let row = ((self.patch_half - y) * self.patch_inv).clamp(0.0, m) as usize;
+        let col = ((x + self.patch_half) * self.patch_inv).max(0.0).min(m) as usize;
+        let row = ((self.patch_half - y) * self.patch_inv).max(0.0).min(m) as usize;
         row * verti_world::surface::PATCHES_PER_SIDE + col
     }
 }
