@@ -1,6 +1,8 @@
 //! `verti`: the command line of the verti off-road mobility benchmark.
 
+mod eval_cmd;
 mod progress;
+mod vehicle_cmd;
 mod world_cmd;
 
 use clap::{Parser, Subcommand};
@@ -21,9 +23,35 @@ enum Command {
     /// Generate, import, inspect and render worlds.
     #[command(subcommand)]
     World(world_cmd::WorldCommand),
+    /// List and inspect vehicles.
+    #[command(subcommand)]
+    Vehicle(vehicle_cmd::VehicleCommand),
+    /// Simulator speed benchmark and robustness soak.
+    #[command(subcommand)]
+    Sim(vehicle_cmd::SimCommand),
+    /// List the mobility systems and their parameters.
+    #[command(subcommand)]
+    Systems(SystemsCommand),
+    /// Evaluate a mobility system on a world set (parallel, resumable).
+    Eval(eval_cmd::EvalArgs),
+    /// Draw one evaluated trial's trajectory over its world.
+    Replay(eval_cmd::ReplayArgs),
+}
+
+#[derive(Subcommand)]
+enum SystemsCommand {
+    /// Every system with its parameters, defaults and ranges.
+    List,
 }
 
 fn main() -> ExitCode {
+    // Behave like other Unix tools when output goes to a closed pipe (`verti ... | head`):
+    // terminate quietly instead of panicking on the failed write.
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of SIGPIPE before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     if let Some(n) = cli.threads {
         if n == 0 {
@@ -31,12 +59,15 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
         // The global pool can only be built once; failing here means it already exists.
-        let _ = rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global();
+        let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
     }
     let result = match cli.command {
         Command::World(cmd) => world_cmd::run(cmd),
+        Command::Vehicle(cmd) => vehicle_cmd::run_vehicle(cmd),
+        Command::Sim(cmd) => vehicle_cmd::run_sim(cmd),
+        Command::Systems(SystemsCommand::List) => eval_cmd::systems_list(),
+        Command::Eval(a) => eval_cmd::eval(a),
+        Command::Replay(a) => eval_cmd::replay(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

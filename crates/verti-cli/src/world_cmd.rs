@@ -22,6 +22,44 @@ pub enum WorldCommand {
     ImportVb(ImportArgs),
     /// Print a summary of one world (a world directory or SET:INDEX, e.g. verti-100:42).
     Show(ShowArgs),
+    /// Render a top view of a world (elevation, classes, obstacles, tasks, paths) to PNG.
+    Render(RenderArgs),
+    /// Statistics of a world set: composition, elevation histograms, frictions, obstacles, paths.
+    Stats(StatsArgs),
+}
+
+#[derive(Args)]
+pub struct RenderArgs {
+    /// A world directory or SET:INDEX (e.g. verti-100:42).
+    world: String,
+    /// Output PNG.
+    #[arg(long)]
+    out: PathBuf,
+    /// Pixels per heightfield cell.
+    #[arg(long, default_value_t = 4)]
+    px_per_cell: u32,
+    /// Only these start/goal pairs (e.g. 0,5); default all.
+    #[arg(long, value_delimiter = ',')]
+    pairs: Option<Vec<u32>>,
+    /// Draw the 16x16 semantic patch grid.
+    #[arg(long)]
+    grid: bool,
+    #[command(flatten)]
+    scale: ScaleArg,
+}
+
+#[derive(Args)]
+pub struct StatsArgs {
+    /// A set: verti-100 (built-in), a set or world directory, or a folder of Verti-Bench worlds.
+    set: String,
+    /// Print one JSON object instead of the text report.
+    #[arg(long)]
+    json: bool,
+    /// Also write the per-level elevation histograms (like the paper's Fig. 2) to this PNG.
+    #[arg(long)]
+    histograms: Option<PathBuf>,
+    #[command(flatten)]
+    scale: ScaleArg,
 }
 
 #[derive(Args)]
@@ -95,6 +133,8 @@ pub fn run(cmd: WorldCommand) -> CmdResult {
         WorldCommand::Generate(a) => generate(a),
         WorldCommand::ImportVb(a) => import(a),
         WorldCommand::Show(a) => show(a),
+        WorldCommand::Render(a) => render(a),
+        WorldCommand::Stats(a) => stats(a),
     }
 }
 
@@ -220,6 +260,42 @@ fn show(a: ShowArgs) -> CmdResult {
     let w = resolve_world(&a.world, a.scale.scale)?;
     print!("{}", describe(&w));
     Ok(())
+}
+
+fn render(a: RenderArgs) -> CmdResult {
+    let w = resolve_world(&a.world, a.scale.scale)?;
+    let options = verti_render::RenderOptions { pixels_per_cell: a.px_per_cell, pairs: a.pairs, show_grid: a.grid, ..Default::default() };
+    ensure_parent(&a.out)?;
+    verti_render::render_world_png(&w, &options, &a.out)?;
+    println!("rendered {} to {}", w.meta.name, a.out.display());
+    Ok(())
+}
+
+fn stats(a: StatsArgs) -> CmdResult {
+    let set = load_set_with_progress(&a.set, a.scale.scale)?;
+    let stats = verti_world::stats::set_stats(&set.worlds);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&stats)?);
+    } else {
+        println!("{}: {} worlds", set.name, set.worlds.len());
+        print!("{stats}");
+    }
+    if let Some(path) = a.histograms {
+        ensure_parent(&path)?;
+        verti_render::elevation_histograms_png(&stats, &path)?;
+        if !a.json {
+            println!("elevation histograms written to {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+/// Creates the parent folder of an output file.
+pub fn ensure_parent(path: &Path) -> Result<(), WorldError> {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => std::fs::create_dir_all(p).map_err(|e| WorldError::io(p, e)),
+        _ => Ok(()),
+    }
 }
 
 /// A short multi-line description of a world.

@@ -1,0 +1,409 @@
+//! One trial: one system drives one vehicle on one task.
+//!
+//! Paper rules (§III-F, §III-G.3): success is reaching within 10 m (scaled with the world) of
+//! the goal, planar, in under 60 s. A trial also ends when the vehicle is stuck: it has stayed
+//! within 1 m (scaled) of its current position for the last 10 s. A failed trial is a
+//! *rollover* if |roll| > 30° at its end, otherwise *stuck* or *timeout*.
+//!
+//! `Rules::VertiBench` reproduces the reference code instead (spec §5): success inside an 8 m
+//! sphere (not scaled) around the goal raised 2 m (scaled) above the ground; stuck when the
+//! vehicle has been slower than 2 m/s (0.01 m per 5 ms step) for 10 s; no rollover class.
+
+use crate::metrics::{AngleStats, SignalStats};
+use crate::observation::{Observation, Pose6};
+use crate::speed::SpeedController;
+use crate::system::{Action, MobilitySystem, TaskInfo};
+use serde::{Deserialize, Serialize};
+use std::collections::VecDeque;
+use std::sync::Arc;
+use std::time::Instant;
+use verti_core::rng::mix_seed;
+use verti_sim::{Controls, Sim, SimState, VehicleSpec, start_pose};
+use verti_world::{TaskId, World};
+
+/// Which success and failure rules apply.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Rules {
+    #[default]
+    Paper,
+    VertiBench,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct EpisodeConfig {
+    pub rules: Rules,
+    /// Time limit, simulated seconds.
+    pub max_time: f64,
+    /// Success radius at full scale, metres (paper rules; multiplied by the world scale).
+    pub success_radius: f64,
+    /// Stuck: window (s) and distance at full scale (m).
+    pub stuck_window: f64,
+    pub stuck_distance: f64,
+    /// Rollover threshold, degrees of |roll|.
+    pub rollover_deg: f64,
+    /// Period of the inner loop (speed controller, metrics, termination checks), seconds.
+    pub inner_dt: f64,
+    /// Keep a per-step log: `None` keeps nothing, `Some(s)` keeps the last `s` seconds
+    /// (`f64::INFINITY` keeps everything).
+    pub log_seconds: Option<f64>,
+    /// Run seed; each trial's system seed is derived from it and the task.
+    pub seed: u64,
+}
+
+impl Default for EpisodeConfig {
+    fn default() -> Self {
+        EpisodeConfig {
+            rules: Rules::Paper,
+            max_time: 60.0,
+            success_radius: 10.0,
+            stuck_window: 10.0,
+            stuck_distance: 1.0,
+            rollover_deg: 30.0,
+            inner_dt: 0.01,
+            log_seconds: None,
+            seed: 0,
+        }
+    }
+}
+
+impl EpisodeConfig {
+    pub fn validate(&self) -> Result<(), String> {
+        let checks = [
+            ("max_time", self.max_time, 0.1, 3600.0),
+            ("success_radius", self.success_radius, 0.0, 1000.0),
+            ("stuck_window", self.stuck_window, 0.1, 3600.0),
+            ("stuck_distance", self.stuck_distance, 0.0, 1000.0),
+            ("rollover_deg", self.rollover_deg, 1.0, 180.0),
+            ("inner_dt", self.inner_dt, 1e-4, 0.1),
+        ];
+        for (name, v, lo, hi) in checks {
+            if !(v.is_finite() && v >= lo && v <= hi) {
+                return Err(format!("episode setting {name} = {v} is outside [{lo}, {hi}]"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// How a trial ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Outcome {
+    Success,
+    Rollover,
+    Stuck,
+    Timeout,
+    /// The simulation or the system failed (non-finite state, invalid action); see `error`.
+    Error,
+}
+
+impl Outcome {
+    pub const ALL: [Outcome; 5] = [Outcome::Success, Outcome::Rollover, Outcome::Stuck, Outcome::Timeout, Outcome::Error];
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Success => "success",
+            Outcome::Rollover => "rollover",
+            Outcome::Stuck => "stuck",
+            Outcome::Timeout => "timeout",
+            Outcome::Error => "error",
+        }
+    }
+}
+
+/// One logged step.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepRecord {
+    pub t: f64,
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+    pub roll: f64,
+    pub pitch: f64,
+    pub yaw: f64,
+    pub vx: f64,
+    pub vy: f64,
+    pub vz: f64,
+    pub wx: f64,
+    pub wy: f64,
+    pub wz: f64,
+    pub throttle: f64,
+    pub brake: f64,
+    pub steering: f64,
+}
+
+/// Everything measured in one trial. Serialised as one JSON line of the results file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrialResult {
+    /// Global task number (1..=1000 for a 100-world set).
+    pub task: u32,
+    pub world: u32,
+    pub pair: u32,
+    pub world_name: String,
+    pub level: verti_world::ElevationLevel,
+    pub terrain_type: verti_world::TerrainType,
+    pub density: verti_world::ObstacleDensity,
+    pub system: String,
+    pub vehicle: String,
+    pub rules: Rules,
+    pub outcome: Outcome,
+    /// Simulated time at the end of the trial, seconds.
+    pub time: f64,
+    /// Time to reach the goal (successes only).
+    pub traversal_time: Option<f64>,
+    /// Roll and pitch in degrees over the trial, raw and absolute.
+    pub roll: AngleStats,
+    pub pitch: AngleStats,
+    pub throttle: SignalStats,
+    pub steering: SignalStats,
+    /// Planar distance driven, metres.
+    pub path_length: f64,
+    /// Planar distance from the goal at the end, metres.
+    pub final_distance: f64,
+    /// |roll| at the end, degrees.
+    pub final_roll: f64,
+    /// Why an `error` trial failed.
+    pub error: Option<String>,
+    /// Wall-clock seconds this trial took (the only field that varies between runs).
+    pub wall_time: f64,
+}
+
+/// Per-step log of a trial (possibly only its last seconds).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EpisodeLog {
+    pub steps: Vec<StepRecord>,
+}
+
+fn pose6(sim: &Sim, state: &SimState) -> Pose6 {
+    let p = sim.reference_pose(state).position;
+    let (roll, pitch, yaw) = state.euler();
+    Pose6 { x: p.x, y: p.y, z: p.z, roll, pitch, yaw }
+}
+
+/// Task information for a system.
+pub fn task_info(world: &World, spec: &VehicleSpec, pair: u32, seed: u64) -> Option<TaskInfo> {
+    let task = world.tasks.iter().find(|t| t.pair == pair)?;
+    let id = TaskId { world: world.meta.index, pair };
+    let path = world.paths.get(world.tasks.iter().position(|t| t.pair == pair)?).map(|p| p.points.clone()).unwrap_or_default();
+    Some(TaskInfo {
+        id,
+        start: task.start,
+        goal: task.goal,
+        global_path: path,
+        world_scale: world.meta.scale,
+        vehicle: spec.name.clone(),
+        wheelbase: spec.wheelbase(),
+        max_steer_angle: spec.steering.max_angle_deg.to_radians(),
+        seed: mix_seed(&[seed, u64::from(id.number())]),
+    })
+}
+
+/// Runs one trial. Never panics on bad system output or simulator blow-ups: those end the trial
+/// with `Outcome::Error` and a message.
+pub fn run_episode(
+    world: &Arc<World>,
+    spec: &VehicleSpec,
+    pair: u32,
+    system: &mut dyn MobilitySystem,
+    cfg: &EpisodeConfig,
+    mut log: Option<&mut EpisodeLog>,
+) -> TrialResult {
+    let wall = Instant::now();
+    let info = task_info(world, spec, pair, cfg.seed);
+    let scale = world.meta.scale;
+    let mut result = TrialResult {
+        task: TaskId { world: world.meta.index, pair }.number(),
+        world: world.meta.index,
+        pair,
+        world_name: world.meta.name.clone(),
+        level: world.meta.level,
+        terrain_type: world.meta.terrain_type,
+        density: world.meta.density,
+        system: system.name().to_string(),
+        vehicle: spec.name.clone(),
+        rules: cfg.rules,
+        outcome: Outcome::Error,
+        time: 0.0,
+        traversal_time: None,
+        roll: AngleStats::default(),
+        pitch: AngleStats::default(),
+        throttle: SignalStats::default(),
+        steering: SignalStats::default(),
+        path_length: 0.0,
+        final_distance: f64::NAN,
+        final_roll: 0.0,
+        error: None,
+        wall_time: 0.0,
+    };
+    let fail = |mut r: TrialResult, msg: String, wall: Instant| {
+        r.outcome = Outcome::Error;
+        r.error = Some(msg);
+        r.wall_time = wall.elapsed().as_secs_f64();
+        r
+    };
+    let Some(info) = info else {
+        return fail(result, format!("world {} has no pair {pair}", world.meta.name), wall);
+    };
+    if let Err(e) = cfg.validate() {
+        return fail(result, e, wall);
+    }
+    let task = world.tasks.iter().find(|t| t.pair == pair).copied().expect("task_info found it");
+    let sim = match start_pose(world, spec, task.start[0], task.start[1], task.start_yaw()).and_then(|p| Sim::new(world, spec, p)) {
+        Ok(s) => s,
+        Err(e) => return fail(result, format!("cannot start the simulation: {e}"), wall),
+    };
+    let mut state = sim.initial_state();
+    system.reset(&info);
+    let rate = system.control_rate();
+    if !(rate.is_finite() && rate > 0.0 && rate <= 1000.0) {
+        return fail(result, format!("system {} has an invalid control rate {rate} Hz", system.name()), wall);
+    }
+    let control_period = 1.0 / rate;
+    let speed = SpeedController::default();
+    let goal_z = world.terrain.height_at(task.goal[0], task.goal[1]) + 2.0 * scale;
+    let success_radius = cfg.success_radius * scale;
+    let stuck_distance = cfg.stuck_distance * scale;
+    let dt = cfg.inner_dt;
+
+    let mut action = Action::HighLevel { speed: 0.0, steering: 0.0 };
+    let mut next_control = 0.0;
+    // positions sampled every 0.1 s for the stuck rule (paper)
+    let mut history: VecDeque<(f64, f64, f64)> = VecDeque::new();
+    let mut next_sample = 0.0;
+    let mut slow_time = 0.0; // reference stuck rule
+    let mut step_index: u64 = 0;
+    let mut pose = pose6(&sim, &state);
+    let mut last_xy = (pose.x, pose.y);
+    let mut last_xyz = (pose.x, pose.y, pose.z);
+
+    let outcome = loop {
+        let t = step_index as f64 * dt;
+        // --- system at its own rate
+        if t + 1e-9 >= next_control {
+            let v_body = state.velocity_body();
+            let obs = Observation::new(world, t, pose, v_body, state.angular_velocity_body(), state.forward_speed(), task.goal, &info.global_path);
+            action = system.act(&obs);
+            next_control += control_period;
+            let ok = match action {
+                Action::HighLevel { speed, steering } => speed.is_finite() && steering.is_finite(),
+                Action::LowLevel(c) => c.validate().is_ok(),
+            };
+            if !ok {
+                result.time = t;
+                return fail(result, format!("system {} returned an invalid action {action:?} at t = {t:.2} s", system.name()), wall);
+            }
+        }
+        let controls: Controls = match action {
+            Action::HighLevel { speed: target, steering } => speed.controls(target, state.forward_speed(), steering),
+            Action::LowLevel(c) => c,
+        };
+        result.throttle.push(controls.throttle - controls.brake);
+        result.steering.push(controls.steering);
+
+        // --- physics
+        if let Err(e) = sim.step(&mut state, controls, dt) {
+            result.time = t;
+            return fail(result, format!("simulation failed at t = {t:.2} s: {e}"), wall);
+        }
+        step_index += 1;
+        let t = step_index as f64 * dt;
+        pose = pose6(&sim, &state);
+        result.roll.push_rad(pose.roll);
+        result.pitch.push_rad(pose.pitch);
+        result.path_length += ((pose.x - last_xy.0).powi(2) + (pose.y - last_xy.1).powi(2)).sqrt();
+        last_xy = (pose.x, pose.y);
+        if let Some(log) = log.as_deref_mut() {
+            let v = state.velocity_body();
+            let w = state.angular_velocity_body();
+            log.steps.push(StepRecord {
+                t,
+                x: pose.x,
+                y: pose.y,
+                z: pose.z,
+                roll: pose.roll,
+                pitch: pose.pitch,
+                yaw: pose.yaw,
+                vx: v.x,
+                vy: v.y,
+                vz: v.z,
+                wx: w.x,
+                wy: w.y,
+                wz: w.z,
+                throttle: controls.throttle,
+                brake: controls.brake,
+                steering: controls.steering,
+            });
+            if let Some(keep) = cfg.log_seconds
+                && keep.is_finite()
+            {
+                let cut = log.steps.partition_point(|s| s.t < t - keep);
+                if cut > 1024 {
+                    log.steps.drain(..cut);
+                }
+            }
+        }
+
+        // --- termination
+        let planar_goal = ((pose.x - task.goal[0]).powi(2) + (pose.y - task.goal[1]).powi(2)).sqrt();
+        match cfg.rules {
+            Rules::Paper => {
+                if planar_goal < success_radius {
+                    break Outcome::Success;
+                }
+                if t + 1e-9 >= next_sample {
+                    history.push_back((t, pose.x, pose.y));
+                    next_sample += 0.1;
+                    while history.front().is_some_and(|h| h.0 < t - cfg.stuck_window - 1e-9) {
+                        history.pop_front();
+                    }
+                    let full_window = history.front().is_some_and(|h| h.0 <= t - cfg.stuck_window + 0.1 + 1e-9);
+                    if full_window
+                        && history.iter().all(|h| ((h.1 - pose.x).powi(2) + (h.2 - pose.y).powi(2)).sqrt() < stuck_distance)
+                    {
+                        break Outcome::Stuck;
+                    }
+                }
+                if t >= cfg.max_time - 1e-9 {
+                    break Outcome::Timeout;
+                }
+            }
+            Rules::VertiBench => {
+                let step = ((pose.x - last_xyz.0).powi(2) + (pose.y - last_xyz.1).powi(2) + (pose.z - last_xyz.2).powi(2)).sqrt();
+                last_xyz = (pose.x, pose.y, pose.z);
+                // 0.01 m per 5 ms step is 2 m/s
+                if step / dt < 2.0 {
+                    slow_time += dt;
+                } else {
+                    slow_time = 0.0;
+                }
+                if slow_time >= cfg.stuck_window - 1e-9 {
+                    break Outcome::Stuck;
+                }
+                let d3 = (planar_goal.powi(2) + (pose.z - goal_z).powi(2)).sqrt();
+                if d3 < 8.0 {
+                    break Outcome::Success;
+                }
+                if t >= cfg.max_time - 1e-9 {
+                    break Outcome::Timeout;
+                }
+            }
+        }
+    };
+    let t = step_index as f64 * dt;
+    result.time = t;
+    result.final_distance = ((pose.x - task.goal[0]).powi(2) + (pose.y - task.goal[1]).powi(2)).sqrt();
+    result.final_roll = pose.roll.to_degrees().abs();
+    result.outcome = match outcome {
+        Outcome::Success => {
+            result.traversal_time = Some(t);
+            Outcome::Success
+        }
+        other if cfg.rules == Rules::Paper && result.final_roll > cfg.rollover_deg => {
+            let _ = other;
+            Outcome::Rollover
+        }
+        other => other,
+    };
+    result.wall_time = wall.elapsed().as_secs_f64();
+    result
+}

@@ -1,0 +1,231 @@
+//! Parallel, deterministic, resumable evaluation.
+//!
+//! Results go to `OUT/results.jsonl`, one JSON object per finished trial, appended and flushed
+//! as each trial ends, so a killed run loses at most the trials in flight; `resume` reads the
+//! file back (dropping a torn last line), skips the tasks already done and appends the rest.
+//! `OUT/run.json` records what was run; resuming with different settings is refused. Each
+//! trial depends only on its task and the run seed, so the results are the same for any
+//! number of jobs (only `wall_time` differs).
+
+use crate::episode::{EpisodeConfig, TrialResult, run_episode};
+use crate::system::MobilitySystem;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeSet;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use verti_sim::VehicleSpec;
+use verti_world::{TaskId, World};
+
+pub const RESULTS_FILE: &str = "results.jsonl";
+pub const RUN_FILE: &str = "run.json";
+
+#[derive(Debug, thiserror::Error)]
+pub enum EvalError {
+    #[error("{0}")]
+    Argument(String),
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}: line {line}: {problem}")]
+    Corrupt { path: PathBuf, line: usize, problem: String },
+}
+
+fn io(path: &Path) -> impl Fn(std::io::Error) -> EvalError + '_ {
+    move |source| EvalError::Io { path: path.to_path_buf(), source }
+}
+
+/// Parses a task selection like `1-1000`, `7`, `1,5,10-20` or `all` into sorted task numbers.
+pub fn parse_tasks(spec: &str) -> Result<Vec<u32>, EvalError> {
+    let bad = |why: String| EvalError::Argument(format!("bad task range `{spec}`: {why}"));
+    if spec.trim() == "all" {
+        return Ok(Vec::new());
+    }
+    let mut out = BTreeSet::new();
+    for part in spec.split(',') {
+        let part = part.trim();
+        if part.is_empty() {
+            return Err(bad("empty item".into()));
+        }
+        let (a, b) = match part.split_once('-') {
+            Some((a, b)) => (a.trim(), b.trim()),
+            None => (part, part),
+        };
+        let a: u32 = a.parse().map_err(|_| bad(format!("`{a}` is not a task number")))?;
+        let b: u32 = b.parse().map_err(|_| bad(format!("`{b}` is not a task number")))?;
+        if a == 0 || b < a {
+            return Err(bad(format!("`{part}` is not an increasing range of task numbers starting at 1")));
+        }
+        if b - a > 10_000_000 {
+            return Err(bad(format!("`{part}` is too large")));
+        }
+        out.extend(a..=b);
+    }
+    Ok(out.into_iter().collect())
+}
+
+/// What a run is; stored in `run.json` and compared on resume.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunInfo {
+    pub system: String,
+    /// System parameters as given (name = value).
+    pub params: Vec<(String, f64)>,
+    pub vehicle: String,
+    pub worlds: String,
+    /// World scale the set was generated or imported at.
+    pub scale: f64,
+    pub rules: crate::episode::Rules,
+    pub seed: u64,
+    pub max_time: f64,
+}
+
+/// Resolves the selected task numbers against a set: all tasks of the set when `selection` is
+/// empty; otherwise each number must name a task of a world in the set.
+pub fn select_tasks(worlds: &[Arc<World>], selection: &[u32]) -> Result<Vec<(usize, u32)>, EvalError> {
+    let mut all = Vec::new();
+    for (wi, w) in worlds.iter().enumerate() {
+        for t in &w.tasks {
+            all.push((TaskId { world: w.meta.index, pair: t.pair }.number(), wi, t.pair));
+        }
+    }
+    all.sort();
+    if selection.is_empty() {
+        return Ok(all.into_iter().map(|(_, w, p)| (w, p)).collect());
+    }
+    let mut out = Vec::with_capacity(selection.len());
+    let mut missing = Vec::new();
+    for &n in selection {
+        match all.binary_search_by_key(&n, |a| a.0) {
+            Ok(i) => out.push((all[i].1, all[i].2)),
+            Err(_) => missing.push(n),
+        }
+    }
+    if !missing.is_empty() {
+        let shown: Vec<String> = missing.iter().take(5).map(|n| n.to_string()).collect();
+        let (lo, hi) = (all.first().map_or(0, |a| a.0), all.last().map_or(0, |a| a.0));
+        return Err(EvalError::Argument(format!(
+            "{} selected task(s) are not in this world set (e.g. {}); it has tasks {lo}..={hi} ({} tasks)",
+            missing.len(),
+            shown.join(", "),
+            all.len()
+        )));
+    }
+    Ok(out)
+}
+
+/// Reads a results file; a torn last line (from a kill) is dropped and reported as `false`.
+pub fn read_results(path: &Path) -> Result<(Vec<TrialResult>, bool), EvalError> {
+    let text = std::fs::read_to_string(path).map_err(io(path))?;
+    let mut out = Vec::new();
+    let lines: Vec<&str> = text.split('\n').collect();
+    let mut clean = true;
+    for (i, line) in lines.iter().enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        match serde_json::from_str::<TrialResult>(line) {
+            Ok(r) => out.push(r),
+            // only the last line may be torn (no trailing newline)
+            Err(_) if i == lines.len() - 1 => clean = false,
+            Err(e) => return Err(EvalError::Corrupt { path: path.to_path_buf(), line: i + 1, problem: e.to_string() }),
+        }
+    }
+    Ok((out, clean))
+}
+
+/// Settings of one evaluation run.
+pub struct EvalSetup<'a> {
+    pub worlds: &'a [Arc<World>],
+    pub vehicle: &'a VehicleSpec,
+    pub episode: EpisodeConfig,
+    pub jobs: usize,
+    pub out: PathBuf,
+    pub resume: bool,
+    /// Overwrite an existing results file instead of refusing.
+    pub force: bool,
+    pub run: RunInfo,
+}
+
+/// Runs the selected tasks; returns all results of the run (earlier and new), sorted by task.
+pub fn evaluate(
+    setup: &EvalSetup,
+    selection: &[u32],
+    make_system: &(dyn Fn() -> Box<dyn MobilitySystem> + Sync),
+    on_result: &(dyn Fn(&TrialResult) + Sync),
+) -> Result<Vec<TrialResult>, EvalError> {
+    if setup.jobs == 0 {
+        return Err(EvalError::Argument("--jobs must be at least 1".into()));
+    }
+    setup.episode.validate().map_err(EvalError::Argument)?;
+    let tasks = select_tasks(setup.worlds, selection)?;
+    std::fs::create_dir_all(&setup.out).map_err(io(&setup.out))?;
+    let results_path = setup.out.join(RESULTS_FILE);
+    let run_path = setup.out.join(RUN_FILE);
+
+    let mut previous = Vec::new();
+    if results_path.exists() && !setup.force {
+        if !setup.resume {
+            return Err(EvalError::Argument(format!(
+                "{} already exists: pass --resume to continue that run or --force to start over",
+                results_path.display()
+            )));
+        }
+        let text = std::fs::read_to_string(&run_path).map_err(io(&run_path))?;
+        let before: RunInfo = serde_json::from_str(&text)
+            .map_err(|e| EvalError::Corrupt { path: run_path.clone(), line: 1, problem: e.to_string() })?;
+        if before != setup.run {
+            return Err(EvalError::Argument(format!(
+                "cannot resume: {} was made with different settings ({before:?}), now {:?}",
+                run_path.display(),
+                setup.run
+            )));
+        }
+        let (rs, clean) = read_results(&results_path)?;
+        if !clean {
+            // rewrite without the torn line so appends start on a fresh line
+            let mut text = String::new();
+            for r in &rs {
+                text.push_str(&serde_json::to_string(r).expect("results serialise"));
+                text.push('\n');
+            }
+            std::fs::write(&results_path, text).map_err(io(&results_path))?;
+        }
+        previous = rs;
+    } else {
+        std::fs::write(&results_path, "").map_err(io(&results_path))?;
+    }
+    std::fs::write(&run_path, serde_json::to_string_pretty(&setup.run).expect("run info serialises")).map_err(io(&run_path))?;
+
+    let done: BTreeSet<u32> = previous.iter().map(|r| r.task).collect();
+    let todo: Vec<(usize, u32)> = tasks
+        .into_iter()
+        .filter(|&(wi, pair)| !done.contains(&TaskId { world: setup.worlds[wi].meta.index, pair }.number()))
+        .collect();
+
+    let file = std::fs::OpenOptions::new().append(true).open(&results_path).map_err(io(&results_path))?;
+    let sink = Mutex::new(file);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(setup.jobs)
+        .build()
+        .map_err(|e| EvalError::Argument(format!("cannot start {} worker threads: {e}", setup.jobs)))?;
+    let fresh: Result<Vec<TrialResult>, EvalError> = pool.install(|| {
+        todo.par_iter()
+            .map(|&(wi, pair)| {
+                let mut system = make_system();
+                let r = run_episode(&setup.worlds[wi], setup.vehicle, pair, system.as_mut(), &setup.episode, None);
+                let mut line = serde_json::to_string(&r).expect("results serialise");
+                line.push('\n');
+                {
+                    let mut f = sink.lock().unwrap_or_else(|p| p.into_inner());
+                    f.write_all(line.as_bytes()).and_then(|_| f.flush()).map_err(io(&results_path))?;
+                }
+                on_result(&r);
+                Ok(r)
+            })
+            .collect()
+    });
+    let mut all = previous;
+    all.extend(fresh?);
+    all.sort_by_key(|r| r.task);
+    Ok(all)
+}

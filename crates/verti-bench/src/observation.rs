@@ -1,0 +1,190 @@
+//! What a system sees: ground-truth vehicle state, the goal and global path, and robot-centred,
+//! heading-aligned crops of elevation, semantic class and obstacle occupancy (paper §III-G.4).
+//!
+//! Crops are computed only when a system asks for them, so a system that needs no map pays
+//! nothing for maps.
+
+use verti_core::Vec3;
+use verti_world::World;
+
+/// Size and resolution of a square crop centred on the vehicle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CropSpec {
+    /// Cells per side.
+    pub size: usize,
+    /// Metres per cell.
+    pub resolution: f64,
+}
+
+/// A heading-aligned crop: row 0 is farthest ahead of the vehicle, column 0 farthest to its
+/// left; the vehicle is at the centre. Row-major.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Crop<T> {
+    pub spec: CropSpec,
+    pub data: Vec<T>,
+}
+
+impl<T: Copy> Crop<T> {
+    pub fn get(&self, row: usize, col: usize) -> T {
+        self.data[row * self.spec.size + col]
+    }
+}
+
+/// Chassis pose: position of the reference point and Z-Y-X Euler angles (radians).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pose6 {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+    pub roll: f64,
+    pub pitch: f64,
+    pub yaw: f64,
+}
+
+/// One observation. Borrowed from the episode; valid during one `act` call.
+pub struct Observation<'a> {
+    world: &'a World,
+    /// Simulated time since the start of the trial, seconds.
+    pub time: f64,
+    pub pose: Pose6,
+    /// Linear velocity in the body frame (x forward, y left, z up), m/s.
+    pub velocity_body: Vec3,
+    /// Angular velocity in the body frame, rad/s.
+    pub angular_velocity_body: Vec3,
+    /// Forward speed (body x), m/s.
+    pub forward_speed: f64,
+    pub goal: [f64; 2],
+    pub global_path: &'a [[f64; 2]],
+    /// Length scale of the world.
+    pub world_scale: f64,
+}
+
+impl<'a> Observation<'a> {
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new(
+        world: &'a World,
+        time: f64,
+        pose: Pose6,
+        velocity_body: Vec3,
+        angular_velocity_body: Vec3,
+        forward_speed: f64,
+        goal: [f64; 2],
+        global_path: &'a [[f64; 2]],
+    ) -> Self {
+        Observation {
+            world,
+            time,
+            pose,
+            velocity_body,
+            angular_velocity_body,
+            forward_speed,
+            goal,
+            global_path,
+            world_scale: world.meta.scale,
+        }
+    }
+
+    /// World (x, y) of the centre of crop cell (row, col).
+    pub fn crop_cell_xy(&self, spec: CropSpec, row: usize, col: usize) -> (f64, f64) {
+        let half = 0.5 * (spec.size as f64 - 1.0);
+        let ahead = (half - row as f64) * spec.resolution;
+        let left = (half - col as f64) * spec.resolution;
+        let (s, c) = self.pose.yaw.sin_cos();
+        (self.pose.x + ahead * c - left * s, self.pose.y + ahead * s + left * c)
+    }
+
+    fn crop<T>(&self, spec: CropSpec, f: impl Fn(f64, f64) -> T) -> Crop<T> {
+        let mut data = Vec::with_capacity(spec.size * spec.size);
+        for r in 0..spec.size {
+            for c in 0..spec.size {
+                let (x, y) = self.crop_cell_xy(spec, r, c);
+                data.push(f(x, y));
+            }
+        }
+        Crop { spec, data }
+    }
+
+    /// Terrain height (m, undeformed) under each cell.
+    pub fn elevation_crop(&self, spec: CropSpec) -> Crop<f64> {
+        self.crop(spec, |x, y| self.world.terrain.height_at(x, y))
+    }
+
+    /// Semantic class id (Verti-Bench label ids 0..9) under each cell.
+    pub fn semantic_crop(&self, spec: CropSpec) -> Crop<u8> {
+        self.crop(spec, |x, y| self.world.patches.at(x, y).class.id())
+    }
+
+    /// 1 where an obstacle footprint covers the cell centre, else 0. Off-map cells read 1 so
+    /// planners keep to the map.
+    pub fn occupancy_crop(&self, spec: CropSpec) -> Crop<u8> {
+        let reach = 0.75 * spec.size as f64 * spec.resolution;
+        let near: Vec<&verti_world::Obstacle> = self
+            .world
+            .obstacles
+            .iter()
+            .filter(|o| {
+                let p = o.position();
+                ((p.x - self.pose.x).powi(2) + (p.y - self.pose.y).powi(2)).sqrt() < reach + o.radius_xy()
+            })
+            .collect();
+        // the bounding-circle test rejects almost every (cell, obstacle) pair before the
+        // polygon test, which keeps large crops cheap enough for a 20 Hz planner
+        self.crop(spec, |x, y| {
+            u8::from(
+                !self.world.terrain.contains(x, y)
+                    || near.iter().any(|o| {
+                        let p = o.position();
+                        let r = o.radius_xy();
+                        (p.x - x).powi(2) + (p.y - y).powi(2) <= r * r && o.footprint_distance(x, y) <= 0.0
+                    }),
+            )
+        })
+    }
+
+    /// Undeformed terrain height at a world point (ground truth, as the paper's systems get).
+    pub fn elevation_at(&self, x: f64, y: f64) -> f64 {
+        self.world.terrain.height_at(x, y)
+    }
+
+    /// Horizontal distance from (x, y) to the nearest obstacle footprint (negative inside).
+    pub fn obstacle_distance(&self, x: f64, y: f64) -> f64 {
+        self.world.obstacle_distance(x, y)
+    }
+
+    /// Half of the map's side length (m): the map spans [-h, h] in x and y.
+    pub fn map_half_extent(&self) -> f64 {
+        self.world.terrain.half_extent()
+    }
+}
+
+/// An observation of a vehicle standing at `xy` with heading `yaw` (for tests and benchmarks of
+/// systems outside an episode).
+pub fn test_observation<'a>(world: &'a World, xy: [f64; 2], yaw: f64, goal: [f64; 2], path: &'a [[f64; 2]]) -> Observation<'a> {
+    let z = world.terrain.height_at(xy[0], xy[1]);
+    let pose = Pose6 { x: xy[0], y: xy[1], z, roll: 0.0, pitch: 0.0, yaw };
+    Observation::new(world, 0.0, pose, Vec3::ZERO, Vec3::ZERO, 0.0, goal, path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use verti_sim::testing;
+
+    #[test]
+    fn crops_are_heading_aligned() {
+        // a plane rising to the east: z = 0.1 x
+        let world = testing::plane_world(1.0, 0.1, 0.0, 0.8);
+        let spec = CropSpec { size: 5, resolution: 1.0 };
+        let pose = Pose6 { x: 0.0, y: 0.0, z: 0.0, roll: 0.0, pitch: 0.0, yaw: 0.0 };
+        let obs = Observation::new(&world, 0.0, pose, Vec3::ZERO, Vec3::ZERO, 0.0, [10.0, 0.0], &[]);
+        let crop = obs.elevation_crop(spec);
+        // facing east: row 0 is 2 m ahead (x = 2), row 4 is 2 m behind
+        assert!((crop.get(0, 2) - 0.2).abs() < 1e-9 && (crop.get(4, 2) + 0.2).abs() < 1e-9);
+        // facing north: the columns run from west (left? no: left of a north-facing robot is west)
+        let pose_n = Pose6 { yaw: std::f64::consts::FRAC_PI_2, ..pose };
+        let obs = Observation::new(&world, 0.0, pose_n, Vec3::ZERO, Vec3::ZERO, 0.0, [10.0, 0.0], &[]);
+        let crop = obs.elevation_crop(spec);
+        assert!((crop.get(2, 0) + 0.2).abs() < 1e-9, "column 0 is the robot's left = west");
+        assert!((crop.get(2, 4) - 0.2).abs() < 1e-9);
+    }
+}

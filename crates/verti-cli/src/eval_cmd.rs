@@ -1,0 +1,214 @@
+//! `verti systems`, `verti eval`, `verti replay`.
+
+use crate::progress::bar;
+use crate::vehicle_cmd::load_vehicle;
+use crate::world_cmd::{CmdResult, ensure_parent, load_set_with_progress};
+use clap::Args;
+use std::path::PathBuf;
+use std::sync::Arc;
+use verti_bench::episode::{EpisodeLog, Outcome, Rules};
+use verti_bench::eval::{EvalSetup, RUN_FILE, RunInfo, evaluate, parse_tasks, read_results};
+use verti_bench::{EpisodeConfig, run_episode};
+use verti_world::World;
+
+pub fn systems_list() -> CmdResult {
+    for s in verti_systems::list() {
+        println!("{}  {}", s.name, s.summary);
+        for p in &s.params {
+            println!("    {:<15} {:>8}   [{}, {}]  {}", p.name, p.default, p.min, p.max, p.doc);
+        }
+    }
+    Ok(())
+}
+
+fn parse_param(s: &str) -> Result<(String, f64), String> {
+    let (k, v) = s.split_once('=').ok_or_else(|| format!("parameter `{s}` must look like name=value"))?;
+    let v: f64 = v.trim().parse().map_err(|_| format!("parameter `{s}`: `{v}` is not a number"))?;
+    Ok((k.trim().to_string(), v))
+}
+
+fn parse_rules(s: &str) -> Result<Rules, String> {
+    match s {
+        "paper" => Ok(Rules::Paper),
+        "verti-bench" => Ok(Rules::VertiBench),
+        other => Err(format!("unknown rules `{other}`: use paper or verti-bench")),
+    }
+}
+
+#[derive(Args)]
+pub struct EvalArgs {
+    /// Mobility system (see `verti systems list`).
+    #[arg(long, default_value = "pid")]
+    system: String,
+    /// System parameter override, name=value (repeatable).
+    #[arg(long = "param", value_parser = parse_param)]
+    params: Vec<(String, f64)>,
+    /// World set: verti-100 (built-in), a set directory, or a folder of Verti-Bench worlds.
+    #[arg(long, default_value = "verti-100")]
+    worlds: String,
+    /// Task numbers, e.g. 1-1000, 5, 1,3,10-20, or all (default: every task of the set).
+    #[arg(long, default_value = "all")]
+    tasks: String,
+    /// Vehicle: a built-in name or a vehicle YAML file (default: hmmwv; the 1/6 and 1/10 sets
+    /// default to artcar and verti4).
+    #[arg(long)]
+    vehicle: Option<String>,
+    /// World scale for built-in and imported sets.
+    #[arg(long, default_value = "1", value_parser = |s: &str| verti_world::scale::parse_scale(s).map_err(|e| e.to_string()))]
+    scale: f64,
+    /// Parallel trials (default: all cores). Results do not depend on it.
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Output directory (default: results/<system>-<set>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Continue an interrupted run in --out, skipping finished tasks.
+    #[arg(long)]
+    resume: bool,
+    /// Start over, discarding the results in --out.
+    #[arg(long, conflicts_with = "resume")]
+    force: bool,
+    /// Success and failure rules: paper (default) or verti-bench (the reference code's).
+    #[arg(long = "compat", default_value = "paper", value_parser = parse_rules)]
+    rules: Rules,
+    /// Time limit per trial, simulated seconds.
+    #[arg(long, default_value_t = 60.0)]
+    max_time: f64,
+    /// Run seed (systems with randomness derive their per-task seed from it).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+/// The default vehicle for a world scale.
+fn default_vehicle(scale: f64) -> &'static str {
+    if (scale - 1.0 / 6.0).abs() < 1e-3 {
+        "artcar"
+    } else if (scale - 0.1).abs() < 1e-3 {
+        "verti4"
+    } else {
+        "hmmwv"
+    }
+}
+
+pub fn eval(a: EvalArgs) -> CmdResult {
+    verti_systems::registry::resolve_params(&a.system, &a.params)?;
+    let selection = parse_tasks(&a.tasks)?;
+    let vehicle_name = a.vehicle.clone().unwrap_or_else(|| default_vehicle(a.scale).to_string());
+    let vehicle = load_vehicle(&vehicle_name)?;
+    let set = load_set_with_progress(&a.worlds, a.scale)?;
+    let worlds: Vec<Arc<World>> = set.worlds.into_iter().map(Arc::new).collect();
+    let out = a.out.unwrap_or_else(|| PathBuf::from("results").join(format!("{}-{}", a.system, set.name)));
+    let jobs = a.jobs.unwrap_or_else(rayon::current_num_threads);
+    let episode = EpisodeConfig { rules: a.rules, max_time: a.max_time, seed: a.seed, ..Default::default() };
+    let setup = EvalSetup {
+        worlds: &worlds,
+        vehicle: &vehicle,
+        episode,
+        jobs,
+        out: out.clone(),
+        resume: a.resume,
+        force: a.force,
+        run: RunInfo {
+            system: a.system.clone(),
+            params: a.params.clone(),
+            vehicle: vehicle.name.clone(),
+            worlds: a.worlds.clone(),
+            scale: a.scale,
+            rules: a.rules,
+            seed: a.seed,
+            max_time: a.max_time,
+        },
+    };
+    let total = verti_bench::eval::select_tasks(&worlds, &selection)?.len();
+    let pb = bar(total as u64, &a.system);
+    let system = a.system.clone();
+    let params = a.params.clone();
+    let make = move || verti_systems::create(&system, &params).expect("parameters were checked");
+    let t0 = std::time::Instant::now();
+    let results = evaluate(&setup, &selection, &make, &|_| pb.inc(1))?;
+    pb.finish_and_clear();
+    let wall = t0.elapsed().as_secs_f64();
+    let count = |o: Outcome| results.iter().filter(|r| r.outcome == o).count();
+    let n = results.len().max(1) as f64;
+    println!(
+        "{} on {} with {} ({} tasks, {} jobs, {:.1} s): success {:.1}%  rollover {:.1}%  stuck {:.1}%  timeout {:.1}%  error {:.1}%",
+        a.system,
+        set.name,
+        vehicle.name,
+        results.len(),
+        jobs,
+        wall,
+        100.0 * count(Outcome::Success) as f64 / n,
+        100.0 * count(Outcome::Rollover) as f64 / n,
+        100.0 * count(Outcome::Stuck) as f64 / n,
+        100.0 * count(Outcome::Timeout) as f64 / n,
+        100.0 * count(Outcome::Error) as f64 / n,
+    );
+    let sim_seconds: f64 = results.iter().map(|r| r.time).sum();
+    println!("simulated {:.0} s in {:.1} s of wall time; results in {}", sim_seconds, wall, out.join("results.jsonl").display());
+    for r in results.iter().filter(|r| r.outcome == Outcome::Error).take(5) {
+        println!("  task {} ({}): {}", r.task, r.world_name, r.error.as_deref().unwrap_or("?"));
+    }
+    Ok(())
+}
+
+#[derive(Args)]
+pub struct ReplayArgs {
+    /// A results directory written by `verti eval`.
+    result: PathBuf,
+    /// Task number to replay.
+    #[arg(long)]
+    task: u32,
+    /// Output PNG.
+    #[arg(long)]
+    out: PathBuf,
+    /// Pixels per heightfield cell.
+    #[arg(long, default_value_t = 4)]
+    px_per_cell: u32,
+}
+
+/// Re-runs one task of an evaluation (trials are deterministic) with a per-step log and draws
+/// its trajectory over the world, coloured by speed, with the failure point marked.
+pub fn replay(a: ReplayArgs) -> CmdResult {
+    let run_path = a.result.join(RUN_FILE);
+    let run: RunInfo = serde_json::from_str(&std::fs::read_to_string(&run_path).map_err(|e| format!("{}: {e}", run_path.display()))?)
+        .map_err(|e| format!("{}: {e}", run_path.display()))?;
+    let (results, _) = read_results(&a.result.join(verti_bench::eval::RESULTS_FILE))?;
+    let recorded = results
+        .iter()
+        .find(|r| r.task == a.task)
+        .ok_or_else(|| format!("task {} is not in {} ({} results)", a.task, a.result.display(), results.len()))?;
+    let vehicle = load_vehicle(&run.vehicle)?;
+    let id = verti_world::TaskId::from_number(a.task).ok_or("task numbers start at 1")?;
+    let world = Arc::new(verti_world::sets::resolve_world(&format!("{}:{}", run.worlds, id.world), run.scale)?);
+    let mut system = verti_systems::create(&run.system, &run.params)?;
+    let cfg = EpisodeConfig { rules: run.rules, max_time: run.max_time, seed: run.seed, log_seconds: Some(f64::INFINITY), ..Default::default() };
+    let mut log = EpisodeLog::default();
+    let replayed = run_episode(&world, &vehicle, id.pair, system.as_mut(), &cfg, Some(&mut log));
+    if replayed.outcome != recorded.outcome || (replayed.time - recorded.time).abs() > 1e-9 {
+        eprintln!(
+            "warning: the replay ended differently ({:?} at {:.2} s) from the recorded trial ({:?} at {:.2} s)",
+            replayed.outcome, replayed.time, recorded.outcome, recorded.time
+        );
+    }
+    let points: Vec<[f64; 2]> = log.steps.iter().map(|s| [s.x, s.y]).collect();
+    let speeds: Vec<f64> = log.steps.iter().map(|s| (s.vx * s.vx + s.vy * s.vy + s.vz * s.vz).sqrt()).collect();
+    let options = verti_render::RenderOptions { pixels_per_cell: a.px_per_cell, pairs: Some(vec![id.pair]), ..Default::default() };
+    let mut img = verti_render::render_world(&world, &options)?;
+    let failure = (replayed.outcome != Outcome::Success).then(|| points.last().copied()).flatten();
+    let style = verti_render::TrajectoryStyle { failure, ..Default::default() };
+    verti_render::draw_trajectory(&mut img, &points, &speeds, &style)?;
+    ensure_parent(&a.out)?;
+    img.save_png(&a.out)?;
+    println!(
+        "task {} ({} pair {}): {} after {:.1} s, {:.1} m driven; trajectory written to {}",
+        a.task,
+        world.meta.name,
+        id.pair,
+        replayed.outcome.name(),
+        replayed.time,
+        replayed.path_length,
+        a.out.display()
+    );
+    Ok(())
+}

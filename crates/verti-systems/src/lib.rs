@@ -1,0 +1,23 @@
+//! # verti-systems
+//!
+//! The classical mobility systems of the paper (§IV-A), built by name with typed, documented
+//! parameters (see [`registry`]):
+//!
+//! * [`pid::Pid`]: follows the global path toward a local goal 10 m ahead, steering from the
+//!   heading error, at 3 m/s.
+//! * [`eh::ElevationHeuristic`]: like PID, but blends in the direction of the region ahead
+//!   whose elevation is most like the ground under the vehicle and least rough.
+//! * [`mppi::Mppi`]: model-predictive path integral control with a kinematic bicycle model and
+//!   obstacle avoidance, the cost accumulated over the whole horizon.
+//!
+//! All speeds and distances are given at full scale and scaled with the world: lengths by the
+//! world scale s, speeds by √s (Froude similarity, so a 1/10-scale vehicle drives the 1/10
+//! world with the same dynamics as the full-scale one drives the full world).
+
+pub mod eh;
+pub mod mppi;
+pub mod path;
+pub mod pid;
+pub mod registry;
+
+pub use registry::{ParamInfo, SystemInfo, create, list};
