@@ -322,6 +322,24 @@ struct SpinGroup {
     driven: bool,
 }
 
+/// Longitudinal tyre force of one wheel, linearised in the new spin rate.
+#[derive(Clone, Copy, Debug, Default)]
+struct LongTyre {
+    active: bool,
+    e_long: Vec3,
+    /// Secant slip stiffness [N per unit slip].
+    stiffness: f64,
+    /// κ_new = a + b·ω_new.
+    a: f64,
+    b: f64,
+    /// Low-speed bristle damping [N s/m].
+    damping: f64,
+    vx: f64,
+    radius: f64,
+    /// Friction left for the longitudinal force after the lateral one [N].
+    limit: f64,
+}
+
 /// Contact of one wheel with everything (summed).
 #[derive(Clone, Copy, Debug, Default)]
 struct WheelContact {
@@ -658,10 +676,49 @@ impl Sim {
         }
         let orientation = pose.orientation.normalized();
         let position = pose.position + orientation.rotate(self.com);
+        // A vehicle at rest on a slope has deflected tyres: preload each tyre's transient slip
+        // with its share of the downhill pull (linear part of the slip curve), so a start on a
+        // slope begins near static equilibrium instead of sliding until the tyres wind up.
+        let t = &self.spec.tyre;
+        let n_wheels = self.wheels.len() as f64;
         let wheels = self
             .wheels
             .iter()
-            .map(|w| WheelState { compression: w.static_compression, soil_patch_b: 2.0 * w.half_width, ..Default::default() })
+            .map(|w| {
+                let hub = position + orientation.rotate(w.attach + Vec3::Z * w.static_compression);
+                let (_, gx, gy) = self.ground.sample(hub.x, hub.y);
+                let n = Vec3::new(-gx, -gy, 1.0).normalized();
+                let axle = orientation.rotate(Vec3::Y);
+                let e_long = axle.cross(n).normalized();
+                let e_lat = n.cross(e_long);
+                let weight = Vec3::new(0.0, 0.0, -GRAVITY * self.total_mass / n_wheels);
+                let fz = -weight.dot(n);
+                let (mut kx, mut ky) = (0.0, 0.0);
+                if fz > 0.0 && e_long.is_finite() {
+                    // invert the slip curve by bisection along the needed force's direction
+                    let (fx, fy) = (-weight.dot(e_long) / fz, -weight.dot(e_lat) / fz);
+                    let need = fx.hypot(fy);
+                    if need > 1e-9 {
+                        let dir = (fx / t.dfx0, fy / t.dfy0);
+                        let dn = dir.0.hypot(dir.1);
+                        let (mut lo, mut hi) = (0.0, t.sxm.min(t.sym) / dn.max(1e-12) * 0.999);
+                        for _ in 0..40 {
+                            let mid = 0.5 * (lo + hi);
+                            let (cx, cy) = tmeasy_combined(mid * dir.0, mid * dir.1, t, 1.0);
+                            if cx.hypot(cy) < need { lo = mid } else { hi = mid }
+                        }
+                        kx = lo * dir.0;
+                        ky = lo * dir.1;
+                    }
+                }
+                WheelState {
+                    compression: w.static_compression,
+                    slip_long: kx,
+                    slip_lat: ky,
+                    soil_patch_b: 2.0 * w.half_width,
+                    ..Default::default()
+                }
+            })
             .collect();
         Ok(SimState {
             time: 0.0,
@@ -852,7 +909,11 @@ impl Sim {
         let mut wheel_susp = [0.0; crate::spec::MAX_WHEELS];
         let mut wheel_k = [0.0; crate::spec::MAX_WHEELS];
         let mut wheel_c = [0.0; crate::spec::MAX_WHEELS];
+        let mut wheel_kc = [0.0; crate::spec::MAX_WHEELS];
+        let mut wheel_cc = [0.0; crate::spec::MAX_WHEELS];
         let mut group_torque = [0.0; crate::spec::MAX_WHEELS];
+        let mut group_k = [0.0; crate::spec::MAX_WHEELS];
+        let mut long_tyre = [LongTyre::default(); crate::spec::MAX_WHEELS];
         let mut slip_inputs = [(0.0, 0.0, 0.0, 0.0, 0.0); crate::spec::MAX_WHEELS]; // (vx, vy, radius, clamp, fz)
         for (w, m) in self.wheels.iter().enumerate() {
             let ws = st.wheels[w];
@@ -886,76 +947,102 @@ impl Sim {
                 c_extra += m.stop_damping;
             }
 
-            // tyre / soil tangential force from the transient slip
+            // tyre / soil tangential force from the transient slip. The lateral force is
+            // explicit; the longitudinal force is solved together with the spin (below).
             let fz_total = contact.rigid_load + contact.soil_load;
             let mut f_ext = gravity * m.unsprung_mass + contact.force;
-            let mut long_force = 0.0;
             let mut lat_force = 0.0;
             let mut roll_torque = 0.0;
+            let mut contact_moment = Vec3::ZERO;
             let mut radius = m.radius;
             let mut slip_clamp = 0.0;
             let (mut vx, mut vy) = (0.0, 0.0);
+            let mut long = LongTyre::default();
             if fz_total > 0.0 {
                 let n = contact.force.normalized();
                 let e_long = axle.cross(n).normalized();
                 let e_lat = n.cross(e_long);
-                vx = v_hub.dot(e_long);
-                vy = v_hub.dot(e_lat);
                 radius = (m.radius - contact.depth).max(0.5 * m.radius);
+                // Slip is measured where the force acts: at the contact, a loaded radius below
+                // the hub, moving with the chassis' rotation too. Measuring it at the hub
+                // while applying the lateral force's moment at the contact feeds roll motion
+                // back into the tyre force and rocks a vehicle parked on a side slope.
+                let v_contact = v_hub + omega_w.cross(n * (-radius));
+                vx = v_contact.dot(e_long);
+                vy = v_contact.dot(e_lat);
                 let (kx, ky) = (ws.slip_long, ws.slip_lat);
-                let (fx, fy);
+                let (fx, fy, initial_slope, limit);
                 if contact.soil_load > contact.rigid_load {
                     // Janosi–Hanamoto traction over the soil patch, Mohr–Coulomb limit
                     let kn = (kx * kx + ky * ky).sqrt();
                     let frac = janosi_fraction(kn, contact.soil_length, contact.soil_janosi_k);
-                    let fmax = contact.soil_shear_limit;
+                    limit = contact.soil_shear_limit;
                     if kn > 1e-12 {
-                        fx = fmax * frac * kx / kn;
-                        fy = fmax * frac * ky / kn;
+                        fx = limit * frac * kx / kn;
+                        fy = limit * frac * ky / kn;
                     } else {
                         fx = 0.0;
                         fy = 0.0;
                     }
+                    initial_slope = limit * 0.5 * contact.soil_length / contact.soil_janosi_k;
                     slip_clamp = janosi_sliding_slip(contact.soil_length, contact.soil_janosi_k);
                 } else {
                     let (cx, cy) = tmeasy_combined(kx, ky, &spec.tyre, contact.mu_scale);
                     fx = cx * fz_total;
                     fy = cy * fz_total;
+                    initial_slope = spec.tyre.dfx0 * fz_total;
+                    limit = spec.tyre.fxm.max(spec.tyre.fym) * contact.mu_scale * fz_total;
                     slip_clamp = -1.0; // rigid: direction-dependent clamp computed later
                 }
                 // Bristle damping fades out with speed (TMeasy blends its Dahl model the same way).
                 let vref = vx.abs().max((spin * radius).abs());
-                let fade = (1.0 - vref / (1.0 * spec.scale.sqrt())).max(0.0);
-                let vslip = vx - spin * radius;
-                let mut fx = fx - fade * m.slip_damping_long * vslip;
+                let fade = (1.0 - vref / spec.scale.sqrt()).max(0.0);
                 let mut fy = fy - fade * m.slip_damping_lat * vy;
-                let limit = if contact.soil_load > contact.rigid_load {
-                    contact.soil_shear_limit
-                } else {
-                    spec.tyre.fxm.max(spec.tyre.fym) * contact.mu_scale * fz_total
-                };
-                let fn_ = (fx * fx + fy * fy).sqrt();
-                if fn_ > limit && fn_ > 0.0 {
-                    fx *= limit / fn_;
-                    fy *= limit / fn_;
-                }
-                long_force = fx;
+                fy = fy.clamp(-limit, limit);
                 lat_force = fy;
-                f_ext += e_long * fx + e_lat * fy;
+                let f_lat = e_lat * fy;
+                f_ext += f_lat;
+                // The ground force acts at the contact, a loaded radius below the hub. The
+                // lateral force's overturning moment reaches the chassis through the bearing;
+                // the longitudinal force's moment about the axle drives the spin.
+                let m_contact = (n * (-radius)).cross(f_lat);
+                contact_moment = m_contact - axle * m_contact.dot(axle);
                 let vroll = spin * radius;
                 roll_torque = -spec.tyre.rolling_resistance * contact.rigid_load * radius * soft_sign(vroll / 0.1);
+                // Longitudinal force linearised in the new spin: F = C·κ_new − c·(vx − ω_new·R)
+                // with the secant stiffness C = F(κ)/κ (the initial slope near κ = 0) and
+                // κ_new = a + b·ω_new from the implicit relaxation update.
+                let secant = if kx.abs() > 1e-6 { (fx / kx).max(0.0) } else { initial_slope };
+                let decay = 1.0 + h * vref / spec.tyre.relaxation_length;
+                long = LongTyre {
+                    active: true,
+                    e_long,
+                    stiffness: secant,
+                    a: (kx - h * vx / spec.tyre.relaxation_length) / decay,
+                    b: h * radius / (spec.tyre.relaxation_length * decay),
+                    damping: fade * m.slip_damping_long,
+                    vx,
+                    radius,
+                    limit: (limit * limit - fy * fy).max(0.0).sqrt(),
+                };
             }
             slip_inputs[w] = (vx, vy, radius, slip_clamp, fz_total);
+            long_tyre[w] = long;
 
-            // spin: tyre reaction, rolling resistance, soil pressure moment about the axle
-            group_torque[m.group] += -long_force * radius + roll_torque + contact.soil_moment.dot(axle);
+            // spin: rolling resistance and the soil pressure moment about the axle (explicit);
+            // the longitudinal tyre force enters the implicit spin solve below
+            group_torque[m.group] += roll_torque + contact.soil_moment.dot(axle);
+            if long.active {
+                group_k[m.group] += long.radius * (long.stiffness * long.b + long.damping * long.radius);
+                group_torque[m.group] -= long.radius * (long.stiffness * long.a - long.damping * long.vx);
+            }
 
             // composite-body force and torque
             let f_axis = f_ext.dot(up);
             force += f_ext;
             // the axle-direction part of the soil moment goes to the spin; the rest to the chassis
             let soil_perp = contact.soil_moment - axle * contact.soil_moment.dot(axle);
-            torque += r.cross(f_ext - up * f_axis + up * f_susp) + soil_perp;
+            torque += r.cross(f_ext - up * f_axis + up * f_susp) + soil_perp + contact_moment;
             axis_force_sum += f_axis;
             susp_sum += f_susp;
             wheel_axis[w] = axle;
@@ -964,10 +1051,11 @@ impl Sim {
             wheel_susp[w] = f_susp;
             wheel_k[w] = k_extra + contact.k_axis;
             wheel_c[w] = c_extra + contact.c_axis;
+            wheel_kc[w] = contact.k_axis;
+            wheel_cc[w] = contact.c_axis;
 
             let out = &mut st.wheels[w];
             out.normal_force = fz_total;
-            out.long_force = long_force;
             out.lat_force = lat_force;
             out.in_contact = fz_total > 0.0;
             out.on_soil = contact.soil_nodes > 0;
@@ -1000,17 +1088,37 @@ impl Sim {
                 }
             }
             let drive = wheel_torque_total * share;
-            let net = drive + group_torque[g];
+            // Implicit spin: (I/h + K)·ω_new = I·ω/h + T, with K the tyres' linearised
+            // longitudinal stiffness against the spin, then Coulomb brakes solved exactly.
+            // Explicitly, a heavily loaded tyre (impacts) overshoots the no-slip speed within
+            // one step and pumps energy into the vehicle.
             let w0 = st.group_spin[g];
-            let free = w0 + h * net / grp.inertia;
-            let stop = h * brake_max / grp.inertia;
-            let (w1, brake_applied) = if free.abs() <= stop {
-                (0.0, -(w0 * grp.inertia / h) - net)
+            let x = grp.inertia * w0 / h + drive + group_torque[g];
+            let denom = grp.inertia / h + group_k[g];
+            let (w1, brake_applied) = if x.abs() <= brake_max {
+                (0.0, -x)
             } else {
-                (free - free.signum() * stop, -free.signum() * brake_max)
+                ((x - x.signum() * brake_max) / denom, -x.signum() * brake_max)
             };
             st.group_spin[g] = w1;
             group_reaction[g] = -(drive + brake_applied) / grp.wheels.len() as f64;
+        }
+        // Longitudinal tyre forces consistent with the new spins, onto the composite body.
+        for (w, m) in self.wheels.iter().enumerate() {
+            let lt = long_tyre[w];
+            if !lt.active {
+                st.wheels[w].long_force = 0.0;
+                continue;
+            }
+            let spin = st.group_spin[m.group];
+            let fx = (lt.stiffness * (lt.a + lt.b * spin) - lt.damping * (lt.vx - spin * lt.radius)).clamp(-lt.limit, lt.limit);
+            let f = lt.e_long * fx;
+            let f_axis = f.dot(up);
+            force += f;
+            torque += wheel_arm[w].cross(f - up * f_axis);
+            axis_force_sum += f_axis;
+            wheel_axis_force[w] += f_axis;
+            st.wheels[w].long_force = fx;
         }
         for (w, m) in self.wheels.iter().enumerate() {
             torque += wheel_axis[w] * group_reaction[m.group];
@@ -1036,11 +1144,19 @@ impl Sim {
         let alpha = q.rotate(alpha_body);
 
         // ---- wheels: implicit suspension update ----
+        // Staggered: the chassis has just been advanced explicitly; each wheel's absolute
+        // velocity along the suspension axis is then solved implicitly against its spring,
+        // damper and contact stiffness, with the contact acting on the wheel's *absolute*
+        // motion (chassis velocity after this step plus compression rate). Linearising the
+        // contact in the compression rate alone gains energy in the heave mode.
         for w in 0..nw {
             let m = &self.wheels[w];
             let r = wheel_arm[w];
             let a_attach = (accel + alpha.cross(r) + omega_w.cross(omega_w.cross(r))).dot(up);
-            let f0 = wheel_axis_force[w] - wheel_susp[w] - m.unsprung_mass * a_attach;
+            let v_attach_new = (st.velocity + omega_w.cross(r)).dot(up) + h * a_attach;
+            let f0 = wheel_axis_force[w] - wheel_susp[w] - m.unsprung_mass * a_attach
+                - wheel_kc[w] * h * v_attach_new
+                - wheel_cc[w] * h * a_attach;
             let ws = &mut st.wheels[w];
             let mc = m.unsprung_mass + h * wheel_c[w];
             let rate = (mc * ws.compression_rate + h * f0) / (mc + h * h * wheel_k[w]);

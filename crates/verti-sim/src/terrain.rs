@@ -171,8 +171,15 @@ impl Ground {
     #[inline]
     pub fn sample(&self, x: f64, y: f64) -> (f64, f64, f64) {
         // max/min compile to single instructions (a NaN coordinate reads cell 0, never panics)
-        let gc = (x * self.inv_cell + self.half).max(0.0).min(self.max_index);
-        let gr = (self.half - y * self.inv_cell).max(0.0).min(self.max_index);
+        let gc_raw = x * self.inv_cell + self.half;
+        let gr_raw = self.half - y * self.inv_cell;
+        let gc = gc_raw.max(0.0).min(self.max_index);
+        let gr = gr_raw.max(0.0).min(self.max_index);
+        // Off the map the ground extends flat-edged: the height no longer changes across the
+        // edge, so neither may the slope (the heightfield's own `sample` keeps the edge cell's
+        // slope there, which would push a vehicle along with a tilted normal on level ground).
+        let keep_x = if gc == gc_raw { 1.0 } else { 0.0 };
+        let keep_y = if gr == gr_raw { 1.0 } else { 0.0 };
         let c0 = (gc as usize).min(self.n - 2);
         let r0 = (gr as usize).min(self.n - 2);
         let u = gc - c0 as f64;
@@ -185,11 +192,11 @@ impl Ground {
         if u >= v {
             let dx = se - sw;
             let dy = ne - se;
-            (sw + u * dx + v * dy, dx * self.inv_cell, dy * self.inv_cell)
+            (sw + u * dx + v * dy, dx * self.inv_cell * keep_x, dy * self.inv_cell * keep_y)
         } else {
             let dy = nw - sw;
             let dx = ne - nw;
-            (sw + v * dy + u * dx, dx * self.inv_cell, dy * self.inv_cell)
+            (sw + v * dy + u * dx, dx * self.inv_cell * keep_x, dy * self.inv_cell * keep_y)
         }
     }
 
@@ -213,12 +220,15 @@ mod tests {
         let g = Ground::new(&w);
         let mut rng = verti_core::Rng::new(5);
         for _ in 0..2000 {
-            let (x, y) = (rng.range(-70.0, 70.0), rng.range(-70.0, 70.0));
+            let (x, y) = (rng.range(-64.0, 64.0), rng.range(-64.0, 64.0));
             let a = g.sample(x, y);
             let b = w.terrain.sample(x, y);
             assert!((a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9 && (a.2 - b.2).abs() < 1e-9);
             let (r, c) = w.patches.index_at(x, y);
             assert_eq!(g.patch_index(x, y), r * 16 + c);
         }
+        // off the map: same height as the edge, level across the edge
+        let (h, gx, _) = g.sample(80.0, 3.0);
+        assert!((h - w.terrain.height_at(64.0, 3.0)).abs() < 1e-9 && gx == 0.0);
     }
 }

@@ -199,3 +199,15 @@ pub fn rough_world(scale: f64, seed: u64, relief: f64, surface: RoughSurface) ->
     w.meta.density = ObstacleDensity::Dense;
     w
 }
+
+/// A tilt table you drive along: the ground rises toward +y with a cross slope that grows
+/// linearly along x, `start_deg` at x = 0 and `deg_per_m` more per metre (world-scaled).
+pub fn twisting_slope_world(scale: f64, start_deg: f64, deg_per_m: f64, friction: f64) -> World {
+    world_from_fn(
+        "twisting-slope",
+        scale,
+        move |x, y| y * (start_deg + deg_per_m * x / scale).clamp(0.0, 85.0).to_radians().tan(),
+        uniform(rigid_patch(friction)),
+        Vec::new(),
+    )
+}
