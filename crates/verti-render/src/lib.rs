@@ -9,17 +9,21 @@
 //!   trajectory coloured by speed with [`draw_trajectory`].
 //! * [`elevation_histograms_png`]: the elevation histograms of a set, one panel per elevation
 //!   level (the paper's Fig. 2 bottom).
+//! * [`grouped_bars_png`]: grouped bar charts in a grid with one colour per series, like the
+//!   paper's Fig. 6 (see [`charts`]).
 //!
 //! Shapes are rasterised here with analytic anti-aliasing (coverage from the signed distance
 //! to each shape); text goes through `plotters` with a vendored DejaVu Sans so output does not
 //! depend on the fonts of the machine.
 
+pub mod charts;
 mod draw;
 mod glyphs;
 mod histogram;
 mod map;
 pub mod palette;
 
+pub use charts::{Panel, Series, grouped_bars_image, grouped_bars_png};
 pub use draw::save_png;
 pub use histogram::{elevation_histograms_image, elevation_histograms_png};
 pub use map::{
