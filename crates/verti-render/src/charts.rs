@@ -54,7 +54,7 @@ const GROUP_FILL: f64 = 0.82;
 
 const LEGEND_ROW: f64 = 22.0;
 const LEGEND_PAD: f64 = 10.0;
-const LEGEND_FONT: f64 = 13.0;
+const LEGEND_FONT: f64 = 14.0;
 const LEGEND_SWATCH: f64 = 12.0;
 const LEGEND_GAP: f64 = 22.0;
 
@@ -64,7 +64,14 @@ const AXIS: Rgb<u8> = Rgb([0x44, 0x44, 0x44]);
 const GRID: Rgb<u8> = Rgb([0xE6, 0xE6, 0xE6]);
 const MUTED: Rgb<u8> = Rgb([0x66, 0x66, 0x66]);
 const WHISKER: Rgb<u8> = Rgb([0x30, 0x30, 0x30]);
-const NA_FONT: f64 = 10.5;
+// Font sizes, all even whole numbers on purpose: plotters 0.3.7 offsets each glyph
+// vertically by `(size / 2 + top of glyph) as i32`, which truncates towards zero, so with an
+// odd or fractional size tall letters (l, t, T) sit a pixel lower than short ones.
+const TITLE_FONT: f64 = 16.0;
+const GROUP_FONT: f64 = 14.0;
+const LABEL_FONT: f64 = 12.0;
+const TICK_FONT: f64 = 12.0;
+const NA_FONT: f64 = 10.0;
 const NA: Rgb<u8> = Rgb([0x80, 0x80, 0x80]);
 
 /// Series colours (Tableau 10: distinct, print well, readable for most colour-blind readers
@@ -320,7 +327,7 @@ fn draw_panel(
         &panel.title,
         px + 0.5 * f64::from(PANEL_WIDTH),
         py + 17.0,
-        14.5,
+        TITLE_FONT,
         INK,
         Anchor::CENTER,
     )?;
@@ -329,7 +336,7 @@ fn draw_panel(
         &panel.y_label,
         px + 16.0,
         0.5 * (b.y0 + b.y1),
-        12.0,
+        LABEL_FONT,
         INK,
     )?;
     // Grid and tick labels.
@@ -346,7 +353,7 @@ fn draw_panel(
             &label,
             b.x0 - 6.0,
             y,
-            11.0,
+            TICK_FONT,
             MUTED,
             Anchor(HPos::Right, VPos::Center),
         )?;
@@ -358,7 +365,7 @@ fn draw_panel(
             "no data",
             0.5 * (b.x0 + b.x1),
             0.5 * (b.y0 + b.y1),
-            13.0,
+            TITLE_FONT,
             MUTED,
             Anchor::CENTER,
         )?;
@@ -372,7 +379,7 @@ fn draw_panel(
             name,
             b.x0 + (g as f64 + 0.5) * slot,
             b.y1 + 15.0,
-            12.5,
+            GROUP_FONT,
             INK,
             Anchor::CENTER,
         )?;
@@ -414,7 +421,7 @@ fn draw_panel(
             if let (Some(e), true) = (e, v.is_finite()) {
                 // On a pixel centre, so the whisker is one crisp pixel column.
                 let cx = (0.5 * (x0 + x1)).floor() + 0.5;
-                let (ya, yb) = (b.y(v - e), b.y(v + e));
+                let (ya, yb) = (b.y(v - e).floor() + 0.5, b.y(v + e).floor() + 0.5);
                 let cap = (0.3 * (x1 - x0)).clamp(1.5, 5.0);
                 polyline(img, &[(cx, ya), (cx, yb)], &[WHISKER], 1.2);
                 polyline(img, &[(cx - cap, ya), (cx + cap, ya)], &[WHISKER], 1.2);
