@@ -2,7 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Running mean, population variance and maximum (Welford).
+/// Running mean, population variance and maximum (Welford's update; the sum of squared
+/// deviations is `var · count`, so nothing hidden is needed to continue after a round trip).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Stats {
     pub count: u64,
@@ -10,22 +11,16 @@ pub struct Stats {
     /// Population variance.
     pub var: f64,
     pub max: f64,
-    #[serde(skip)]
-    m2: f64,
 }
 
 impl Stats {
     pub fn push(&mut self, x: f64) {
-        if self.count == 0 {
-            self.max = x;
-        } else {
-            self.max = self.max.max(x);
-        }
+        self.max = if self.count == 0 { x } else { self.max.max(x) };
+        let m2 = self.var * self.count as f64;
         self.count += 1;
         let d = x - self.mean;
         self.mean += d / self.count as f64;
-        self.m2 += d * (x - self.mean);
-        self.var = self.m2 / self.count as f64;
+        self.var = (m2 + d * (x - self.mean)) / self.count as f64;
     }
 
     pub fn from_iter(xs: impl IntoIterator<Item = f64>) -> Stats {
@@ -41,22 +36,21 @@ impl Stats {
 /// smoothness.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SignalStats {
+    pub samples: u64,
     pub mean_abs: f64,
     pub total_variation: f64,
-    #[serde(skip)]
-    count: u64,
-    #[serde(skip)]
-    last: Option<f64>,
+    /// The latest sample (needed to continue the total variation).
+    pub last: f64,
 }
 
 impl SignalStats {
     pub fn push(&mut self, x: f64) {
-        self.count += 1;
-        self.mean_abs += (x.abs() - self.mean_abs) / self.count as f64;
-        if let Some(l) = self.last {
-            self.total_variation += (x - l).abs();
+        if self.samples > 0 {
+            self.total_variation += (x - self.last).abs();
         }
-        self.last = Some(x);
+        self.samples += 1;
+        self.mean_abs += (x.abs() - self.mean_abs) / self.samples as f64;
+        self.last = x;
     }
 }
 

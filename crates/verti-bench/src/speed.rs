@@ -33,7 +33,7 @@ mod tests {
     fn splits_into_throttle_and_brake() {
         let c = SpeedController::default();
         assert_eq!(c.controls(3.0, 2.5, 0.2), Controls::new(0.5, 0.0, 0.2));
-        assert_eq!(c.controls(3.0, 3.4, 0.0).brake, 0.4000000000000001);
+        assert!((c.controls(3.0, 3.4, 0.0).brake - 0.4).abs() < 1e-12);
         assert_eq!(c.controls(10.0, 0.0, 5.0), Controls::new(1.0, 0.0, 1.0));
         assert_eq!(c.controls(0.0, 5.0, -5.0), Controls::new(0.0, 1.0, -1.0));
     }

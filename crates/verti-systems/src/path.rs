@@ -57,9 +57,10 @@ mod tests {
         let path: Vec<[f64; 2]> = (0..=100).map(|i| [i as f64, 0.0]).collect();
         let mut f = PathFollower::new(path);
         assert_eq!(f.local_goal(0.0, 0.0, 10.0, [0.0; 2]), [10.0, 0.0]);
-        assert_eq!(f.local_goal(20.2, 1.0, 10.0, [0.0; 2]), [30.0, 0.0]);
-        // moving backwards does not pull the goal back
-        assert_eq!(f.local_goal(5.0, 0.0, 10.0, [0.0; 2]), [30.0, 0.0]);
+        // from (20.2, 1), point 30 is sqrt(9.8² + 1) = 9.85 m away, so the goal is point 31
+        assert_eq!(f.local_goal(20.2, 1.0, 10.0, [0.0; 2]), [31.0, 0.0]);
+        // moving backwards does not pull the goal behind the progress point (20, now 15 m away)
+        assert_eq!(f.local_goal(5.0, 0.0, 10.0, [0.0; 2]), [20.0, 0.0]);
         assert_eq!(f.local_goal(95.0, 0.0, 10.0, [0.0; 2]), [100.0, 0.0]);
         let mut empty = PathFollower::new(vec![]);
         assert_eq!(empty.local_goal(0.0, 0.0, 10.0, [7.0, 7.0]), [7.0, 7.0]);

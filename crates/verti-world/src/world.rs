@@ -162,8 +162,10 @@ pub struct TaskId {
 
 impl TaskId {
     /// 1-based global number: world 1 pair 0 is task 1, world 100 pair 9 is task 1000.
+    /// World indices start at 1; an unindexed world (0, as in hand-built test worlds) numbers
+    /// its tasks like world 1 instead of overflowing.
     pub fn number(self) -> u32 {
-        (self.world - 1) * PAIRS_PER_WORLD + self.pair + 1
+        self.world.saturating_sub(1) * PAIRS_PER_WORLD + self.pair + 1
     }
     pub fn from_number(n: u32) -> Option<TaskId> {
         if n == 0 {
