@@ -54,7 +54,10 @@ impl MeanVar {
     /// Statistics of the finite values of `xs` (non-finite values are skipped, so a single
     /// corrupt number cannot turn a whole column into NaN).
     pub fn of(xs: impl IntoIterator<Item = f64>) -> MeanVar {
-        let s = Stats::from_iter(xs.into_iter().filter(|x| x.is_finite()));
+        let mut s = Stats::default();
+        for x in xs.into_iter().filter(|x| x.is_finite()) {
+            s.push(x);
+        }
         if s.count == 0 {
             return MeanVar::default();
         }
