@@ -7,7 +7,10 @@ fn main() {
     let seconds: f64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(60.0);
     let runs: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(3);
     let specs = if args.len() > 3 {
-        args[3..].iter().map(|n| vehicles::builtin(n).unwrap()).collect()
+        args[3..]
+            .iter()
+            .map(|n| vehicles::builtin(n).unwrap())
+            .collect()
     } else {
         vehicles::all_builtin()
     };

@@ -20,11 +20,24 @@ fn main() {
         "roughsoil" => testing::rough_world(s, 2, 4.8, testing::RoughSurface::Soil),
         _ => testing::flat_world(s, 0.8),
     });
-    let sim = Sim::new(&world, &spec, start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap()).unwrap();
+    let sim = Sim::new(
+        &world,
+        &spec,
+        start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
+    )
+    .unwrap();
     let mut st = sim.initial_state();
-    println!("start z {:.4} energy {:.1}", st.com_position().z, sim.energy(&st));
+    println!(
+        "start z {:.4} energy {:.1}",
+        st.com_position().z,
+        sim.energy(&st)
+    );
     for k in 0..200 {
-        let c = if k < 20 { Controls::IDLE } else { Controls::new(throttle, 0.0, steer) };
+        let c = if k < 20 {
+            Controls::IDLE
+        } else {
+            Controls::new(throttle, 0.0, steer)
+        };
         if let Err(e) = sim.step(&mut st, c, 0.05) {
             println!("error {e}");
             break;
@@ -32,10 +45,29 @@ fn main() {
         if k % 10 == 9 {
             let p = st.com_position();
             let (r, pi, y) = st.euler();
-            let w: Vec<String> = st.wheels().iter().map(|w| format!("{:.0}/{:.3}/{:.3}", w.normal_force, w.compression, w.sinkage)).collect();
+            let w: Vec<String> = st
+                .wheels()
+                .iter()
+                .map(|w| {
+                    format!(
+                        "{:.0}/{:.3}/{:.3}",
+                        w.normal_force, w.compression, w.sinkage
+                    )
+                })
+                .collect();
             println!(
                 "t {:5.2} p ({:7.2} {:7.2} {:6.3}) rpy ({:5.1} {:5.1} {:6.1}) v {:6.2} gear {} E {:.0} wheels {}",
-                st.time(), p.x, p.y, p.z, r.to_degrees(), pi.to_degrees(), y.to_degrees(), st.forward_speed(), st.gear(), sim.energy(&st), w.join(" ")
+                st.time(),
+                p.x,
+                p.y,
+                p.z,
+                r.to_degrees(),
+                pi.to_degrees(),
+                y.to_degrees(),
+                st.forward_speed(),
+                st.gear(),
+                sim.energy(&st),
+                w.join(" ")
             );
         }
     }

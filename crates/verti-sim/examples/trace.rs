@@ -6,8 +6,17 @@ fn main() {
     let spec = vehicles::builtin(args.get(1).map_or("hmmwv", |s| s.as_str())).unwrap();
     let worlds = BenchWorlds::synthetic(&[spec.scale]);
     let pair = &worlds.pairs[0];
-    let world = if args.get(2).map(|s| s.as_str()) == Some("soil") { &pair.soil } else { &pair.rigid };
-    let sim = Sim::new(world, &spec, start_pose(world, &spec, 0.0, 0.0, 0.3).unwrap()).unwrap();
+    let world = if args.get(2).map(|s| s.as_str()) == Some("soil") {
+        &pair.soil
+    } else {
+        &pair.rigid
+    };
+    let sim = Sim::new(
+        world,
+        &spec,
+        start_pose(world, &spec, 0.0, 0.0, 0.3).unwrap(),
+    )
+    .unwrap();
     let mut st = sim.initial_state();
     for k in 0..3000 {
         let c = bench_controls(st.time(), st.forward_speed(), world.meta.scale);
@@ -18,11 +27,30 @@ fn main() {
         if (k % 100 == 99) || (std::env::var("FINE").is_ok() && k > 100 && k < 200 && k % 5 == 0) {
             let p = st.com_position();
             let (r, pi, y) = st.euler();
-            let w: Vec<String> = st.wheels().iter().map(|w| format!("{:.0}/{:.2}/{:.2}", w.normal_force, w.sinkage, w.spin_rate)).collect();
+            let w: Vec<String> = st
+                .wheels()
+                .iter()
+                .map(|w| format!("{:.0}/{:.2}/{:.2}", w.normal_force, w.sinkage, w.spin_rate))
+                .collect();
             println!(
                 "t {:5.1} p ({:7.2} {:7.2} {:6.2}) rpy ({:6.1} {:6.1} {:6.1}) v {:6.2} |v| {:6.2} c {:.2}/{:.2} cont {:?} w {}",
-                st.time(), p.x, p.y, p.z, r.to_degrees(), pi.to_degrees(), y.to_degrees(), st.forward_speed(), st.velocity_world().norm(), c.throttle, c.brake,
-                (st.contacts().chassis_terrain_points, st.contacts().chassis_obstacle_points, st.contacts().wheel_obstacle_contacts), w.join(" ")
+                st.time(),
+                p.x,
+                p.y,
+                p.z,
+                r.to_degrees(),
+                pi.to_degrees(),
+                y.to_degrees(),
+                st.forward_speed(),
+                st.velocity_world().norm(),
+                c.throttle,
+                c.brake,
+                (
+                    st.contacts().chassis_terrain_points,
+                    st.contacts().chassis_obstacle_points,
+                    st.contacts().wheel_obstacle_contacts
+                ),
+                w.join(" ")
             );
         }
     }

@@ -53,7 +53,9 @@ impl BenchWorlds {
 
     /// The pair whose scale is closest to `scale`.
     pub fn pair_for(&self, scale: f64) -> Option<&BenchWorldPair> {
-        self.pairs.iter().min_by(|a, b| (a.scale - scale).abs().total_cmp(&(b.scale - scale).abs()))
+        self.pairs
+            .iter()
+            .min_by(|a, b| (a.scale - scale).abs().total_cmp(&(b.scale - scale).abs()))
     }
 }
 
@@ -89,7 +91,11 @@ pub struct BenchReport {
 
 impl fmt::Display for BenchReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "{:<8} {:<6} {:>8} {:>10} {:>10} {:>9} {:>9}  note", "vehicle", "ground", "sim s", "RTF", "µs/step", "steps", "dist m")?;
+        writeln!(
+            f,
+            "{:<8} {:<6} {:>8} {:>10} {:>10} {:>9} {:>9}  note",
+            "vehicle", "ground", "sim s", "RTF", "µs/step", "steps", "dist m"
+        )?;
         for c in &self.cases {
             writeln!(
                 f,
@@ -113,24 +119,36 @@ impl fmt::Display for BenchReport {
 /// keeps the vehicle circling near the map centre.
 pub fn bench_controls(t: f64, forward_speed: f64, scale: f64) -> Controls {
     let u = (4.0 * scale.sqrt() - forward_speed).clamp(-1.0, 1.0);
-    Controls { throttle: u.max(0.0), brake: (-u).max(0.0), steering: 0.35 + 0.25 * (0.25 * t).sin() }
+    Controls {
+        throttle: u.max(0.0),
+        brake: (-u).max(0.0),
+        steering: 0.35 + 0.25 * (0.25 * t).sin(),
+    }
 }
 
 /// Drives each vehicle for `sim_seconds` on the rigid and the soil world of its scale with
 /// [`bench_controls`] at a 50 Hz control rate, `runs` times, single-threaded, and reports the
 /// median real-time factor per case.
-pub fn bench(worlds: &BenchWorlds, vehicles: &[VehicleSpec], sim_seconds: f64, runs: usize) -> BenchReport {
+pub fn bench(
+    worlds: &BenchWorlds,
+    vehicles: &[VehicleSpec],
+    sim_seconds: f64,
+    runs: usize,
+) -> BenchReport {
     let mut cases = Vec::new();
     let control_dt = 0.02;
     for spec in vehicles {
-        let Some(pair) = worlds.pair_for(spec.scale) else { continue };
+        let Some(pair) = worlds.pair_for(spec.scale) else {
+            continue;
+        };
         for (terrain, world) in [("rigid", &pair.rigid), ("soil", &pair.soil)] {
             let mut rtfs = Vec::new();
             let mut walls = Vec::new();
             let mut error = None;
             let mut distance = 0.0;
             let mut steps = 0;
-            let setup = start_pose(world, spec, 0.0, 0.0, 0.3).and_then(|p| Sim::new(world, spec, p));
+            let setup =
+                start_pose(world, spec, 0.0, 0.0, 0.3).and_then(|p| Sim::new(world, spec, p));
             let sim = match setup {
                 Ok(s) => s,
                 Err(e) => {
@@ -158,7 +176,8 @@ pub fn bench(worlds: &BenchWorlds, vehicles: &[VehicleSpec], sim_seconds: f64, r
                 let start = state.com_position();
                 let t0 = Instant::now();
                 for _ in 0..n {
-                    let controls = bench_controls(state.time(), state.forward_speed(), world.meta.scale);
+                    let controls =
+                        bench_controls(state.time(), state.forward_speed(), world.meta.scale);
                     if let Err(e) = sim.step(&mut state, controls, control_dt) {
                         error = Some(e.to_string());
                         break;
@@ -235,7 +254,11 @@ impl fmt::Display for SoakReport {
             self.max_speed
         )?;
         for fl in &self.failures {
-            writeln!(f, "  FAIL {} on {} episode {} (seed {}), t = {:.3}: {}", fl.vehicle, fl.world, fl.episode, fl.episode_seed, fl.time, fl.error)?;
+            writeln!(
+                f,
+                "  FAIL {} on {} episode {} (seed {}), t = {:.3}: {}",
+                fl.vehicle, fl.world, fl.episode, fl.episode_seed, fl.time, fl.error
+            )?;
         }
         Ok(())
     }
@@ -245,16 +268,31 @@ impl fmt::Display for SoakReport {
 /// whose scale matches it (within 1 %; all vehicles when none matches), `steps` control steps
 /// of 10 ms in all, in episodes of up to 60 s from random starts. An episode that errors is
 /// recorded and ended; the others are unaffected. `progress` gets the steps done so far.
-pub fn soak(worlds: &[Arc<World>], vehicles: &[VehicleSpec], steps: u64, seed: u64, progress: impl Fn(u64)) -> SoakReport {
+pub fn soak(
+    worlds: &[Arc<World>],
+    vehicles: &[VehicleSpec],
+    steps: u64,
+    seed: u64,
+    progress: impl Fn(u64),
+) -> SoakReport {
     let control_dt = 0.01;
     let episode_steps = (60.0 / control_dt) as u64;
-    let mut report = SoakReport { control_dt, ..Default::default() };
+    let mut report = SoakReport {
+        control_dt,
+        ..Default::default()
+    };
     let t0 = Instant::now();
     let mut pairs = Vec::new();
     for w in worlds {
-        let matching: Vec<&VehicleSpec> =
-            vehicles.iter().filter(|v| (v.scale / w.meta.scale - 1.0).abs() < 0.01).collect();
-        let chosen = if matching.is_empty() { vehicles.iter().collect() } else { matching };
+        let matching: Vec<&VehicleSpec> = vehicles
+            .iter()
+            .filter(|v| (v.scale / w.meta.scale - 1.0).abs() < 0.01)
+            .collect();
+        let chosen = if matching.is_empty() {
+            vehicles.iter().collect()
+        } else {
+            matching
+        };
         for v in chosen {
             pairs.push((Arc::clone(w), v.clone()));
         }
@@ -269,7 +307,11 @@ pub fn soak(worlds: &[Arc<World>], vehicles: &[VehicleSpec], steps: u64, seed: u
         let ep_seed = verti_core::rng::mix_seed(&[seed, episode]);
         let mut rng = Rng::new(ep_seed);
         let half = world.terrain.half_extent() * 0.8;
-        let (x, y, yaw) = (rng.range(-half, half), rng.range(-half, half), rng.range(-3.14, 3.14));
+        let (x, y, yaw) = (
+            rng.range(-half, half),
+            rng.range(-half, half),
+            rng.range(-3.14, 3.14),
+        );
         let record = |report: &mut SoakReport, e: SimError, time: f64| {
             report.failures.push(SoakFailure {
                 world: world.meta.name.clone(),
@@ -296,8 +338,16 @@ pub fn soak(worlds: &[Arc<World>], vehicles: &[VehicleSpec], steps: u64, seed: u
         let budget = episode_steps.min(steps - done);
         for _ in 0..budget {
             if hold <= 0.0 {
-                let brake = if rng.uniform() < 0.15 { rng.uniform() } else { 0.0 };
-                controls = Controls { throttle: rng.uniform(), brake, steering: rng.range(-1.0, 1.0) };
+                let brake = if rng.uniform() < 0.15 {
+                    rng.uniform()
+                } else {
+                    0.0
+                };
+                controls = Controls {
+                    throttle: rng.uniform(),
+                    brake,
+                    steering: rng.range(-1.0, 1.0),
+                };
                 hold = rng.range(0.1, 2.0);
             }
             hold -= control_dt;
@@ -312,7 +362,10 @@ pub fn soak(worlds: &[Arc<World>], vehicles: &[VehicleSpec], steps: u64, seed: u
             }
             report.max_speed = report.max_speed.max(state.velocity_world().norm());
             rolled |= state.is_rolled_over();
-            if !world.terrain.contains(state.com_position().x, state.com_position().y) {
+            if !world
+                .terrain
+                .contains(state.com_position().x, state.com_position().y)
+            {
                 break; // drove off the map: start a new episode
             }
         }

@@ -17,7 +17,11 @@ pub enum SpecError {
     Parse { origin: String, message: String },
     /// A field has a value the engine cannot simulate.
     #[error("{origin}: field `{field}`: {problem}")]
-    Invalid { origin: String, field: String, problem: String },
+    Invalid {
+        origin: String,
+        field: String,
+        problem: String,
+    },
     /// `vehicles::builtin` was asked for a name it does not know.
     #[error("unknown vehicle `{name}`; built-in vehicles are: {known}")]
     UnknownVehicle { name: String, known: String },
@@ -28,7 +32,12 @@ pub enum SpecError {
 pub enum SimError {
     /// A control input is NaN or outside its range.
     #[error("invalid control `{name}` = {value}: must be a finite number in [{lo}, {hi}]")]
-    InvalidControl { name: &'static str, value: f64, lo: f64, hi: f64 },
+    InvalidControl {
+        name: &'static str,
+        value: f64,
+        lo: f64,
+        hi: f64,
+    },
     /// The requested step is not a positive finite duration.
     #[error("invalid step dt = {0}: must be finite and in (0, 10] seconds")]
     InvalidStep(f64),

@@ -29,7 +29,8 @@ pub const RPM_TO_RAD_S: f64 = std::f64::consts::PI / 30.0;
 #[inline]
 pub fn engine_torque(p: &PowertrainSpec, omega: f64, throttle: f64) -> f64 {
     let w = omega.clamp(0.0, p.max_speed_rpm * RPM_TO_RAD_S);
-    interpolate(&p.zero_throttle, w) * (1.0 - throttle) + interpolate(&p.full_throttle, w) * throttle
+    interpolate(&p.zero_throttle, w) * (1.0 - throttle)
+        + interpolate(&p.full_throttle, w) * throttle
 }
 
 /// The gear after applying the shift rules once at engine speed `omega` [rad/s].

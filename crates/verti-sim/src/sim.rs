@@ -56,10 +56,18 @@ pub struct Controls {
 }
 
 impl Controls {
-    pub const IDLE: Controls = Controls { throttle: 0.0, brake: 0.0, steering: 0.0 };
+    pub const IDLE: Controls = Controls {
+        throttle: 0.0,
+        brake: 0.0,
+        steering: 0.0,
+    };
 
     pub fn new(throttle: f64, brake: f64, steering: f64) -> Controls {
-        Controls { throttle, brake, steering }
+        Controls {
+            throttle,
+            brake,
+            steering,
+        }
     }
 
     /// Rejects NaN and out-of-range values with an error naming the input.
@@ -70,7 +78,12 @@ impl Controls {
             ("steering", self.steering, -1.0, 1.0),
         ] {
             if !(value.is_finite() && value >= lo && value <= hi) {
-                return Err(SimError::InvalidControl { name, value, lo, hi });
+                return Err(SimError::InvalidControl {
+                    name,
+                    value,
+                    lo,
+                    hi,
+                });
             }
         }
         Ok(())
@@ -230,7 +243,12 @@ impl SimState {
         self.velocity = velocity_world;
         let forward = self.orientation.rotate(Vec3::X).dot(velocity_world);
         for (g, grp) in sim.groups.iter().enumerate() {
-            let r = grp.wheels.iter().map(|&w| sim.wheels[w].radius).sum::<f64>() / grp.wheels.len() as f64;
+            let r = grp
+                .wheels
+                .iter()
+                .map(|&w| sim.wheels[w].radius)
+                .sum::<f64>()
+                / grp.wheels.len() as f64;
             self.group_spin[g] = forward / r;
         }
     }
@@ -241,7 +259,10 @@ impl SimState {
 
     /// Checks that every state variable is finite and within sane bounds.
     fn check(&self, scale: f64) -> Result<(), SimError> {
-        let nf = |what: &str| SimError::NonFinite { what: what.to_string(), time: self.time };
+        let nf = |what: &str| SimError::NonFinite {
+            what: what.to_string(),
+            time: self.time,
+        };
         if !self.position.is_finite() {
             return Err(nf("chassis position"));
         }
@@ -268,15 +289,33 @@ impl SimState {
             }
         }
         let limit = POSITION_LIMIT * scale.max(1e-3);
-        if self.position.x.abs() > limit || self.position.y.abs() > limit || self.position.z.abs() > limit {
-            return Err(SimError::BlowUp { what: format!("chassis position {:?} is absurdly far", self.position), time: self.time });
+        if self.position.x.abs() > limit
+            || self.position.y.abs() > limit
+            || self.position.z.abs() > limit
+        {
+            return Err(SimError::BlowUp {
+                what: format!("chassis position {:?} is absurdly far", self.position),
+                time: self.time,
+            });
         }
         let vmax = SPEED_LIMIT * scale.max(1e-3).sqrt();
         if self.velocity.norm() > vmax {
-            return Err(SimError::BlowUp { what: format!("chassis speed {:.1} m/s exceeds {vmax:.0} m/s", self.velocity.norm()), time: self.time });
+            return Err(SimError::BlowUp {
+                what: format!(
+                    "chassis speed {:.1} m/s exceeds {vmax:.0} m/s",
+                    self.velocity.norm()
+                ),
+                time: self.time,
+            });
         }
         if self.omega.norm() > 1000.0 {
-            return Err(SimError::BlowUp { what: format!("chassis spin {:.1} rad/s exceeds 1000 rad/s", self.omega.norm()), time: self.time });
+            return Err(SimError::BlowUp {
+                what: format!(
+                    "chassis spin {:.1} rad/s exceeds 1000 rad/s",
+                    self.omega.norm()
+                ),
+                time: self.time,
+            });
         }
         Ok(())
     }
@@ -307,6 +346,8 @@ struct WheelModel {
     /// Low-speed damping of the transient slip [N s/m] (bristle damping).
     slip_damping_long: f64,
     slip_damping_lat: f64,
+    /// Nominal static load [N]: sets the fixed stiffness of the tyre at standstill.
+    nominal_load: f64,
     /// Static compression at the start pose.
     static_compression: f64,
 }
@@ -348,6 +389,9 @@ struct WheelContact {
     /// Stiffness and damping along the suspension axis (for the implicit wheel update).
     k_axis: f64,
     c_axis: f64,
+    /// Σ k·(n·u)·n and Σ c·(n·u)·n: how the axis force depends on the chassis' motion.
+    k_vec: Vec3,
+    c_vec: Vec3,
     /// Rigid part: normal load and friction scale (ground μ / tyre μ), load-weighted.
     rigid_load: f64,
     mu_scale: f64,
@@ -398,10 +442,19 @@ pub struct Sim {
 }
 
 /// Places a vehicle at (x, y) with heading `yaw`, pitched and rolled to the terrain plane fitted
-/// under its wheels, with every tyre just touching the ground at its static spring compression.
-pub fn start_pose(world: &World, spec: &VehicleSpec, x: f64, y: f64, yaw: f64) -> Result<Pose, SimError> {
+/// under its wheels, springs at their static compression and tyres at their static deflection
+/// (on soil the wheels then start slightly sunk and settle by the soil's sinkage).
+pub fn start_pose(
+    world: &World,
+    spec: &VehicleSpec,
+    x: f64,
+    y: f64,
+    yaw: f64,
+) -> Result<Pose, SimError> {
     if !(x.is_finite() && y.is_finite() && yaw.is_finite()) {
-        return Err(SimError::InvalidStart(format!("({x}, {y}, yaw {yaw}) is not finite")));
+        return Err(SimError::InvalidStart(format!(
+            "({x}, {y}, yaw {yaw}) is not finite"
+        )));
     }
     if !world.terrain.contains(x, y) {
         return Err(SimError::InvalidStart(format!(
@@ -432,7 +485,17 @@ pub fn start_pose(world: &World, spec: &VehicleSpec, x: f64, y: f64, yaw: f64) -
     let slope_x = if sxx > 1e-12 { sxh / sxx } else { 0.0 };
     let slope_y = if syy > 1e-12 { syh / syy } else { 0.0 };
     let orientation = Quat::from_euler(slope_y.atan(), -slope_x.atan(), yaw);
-    // Lowest reference height at which no tyre penetrates.
+    // Seat every tyre at its static deflection under an equal share of the weight (so a
+    // vehicle set down on flat ground barely moves), and no tyre deeper than that.
+    let weight = (spec.chassis.mass
+        + spec.track.map_or(0.0, |t| 2.0 * t.track_mass)
+        + spec
+            .axles
+            .iter()
+            .map(|a| 2.0 * a.wheel.unsprung_mass)
+            .sum::<f64>())
+        * GRAVITY;
+    let deflection = weight / spec.wheel_count() as f64 / spec.tyre.radial_stiffness;
     let mut z = f64::NEG_INFINITY;
     for (lx, ly, _, k) in &rows {
         let ax = &spec.axles[*k];
@@ -441,10 +504,12 @@ pub fn start_pose(world: &World, spec: &VehicleSpec, x: f64, y: f64, yaw: f64) -
         let (hx, hy) = (x + hub.x, y + hub.y);
         let (h, gx, gy) = hf.sample(hx, hy);
         let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
-        z = z.max(h + ax.wheel.radius / nz - hub.z);
+        z = z.max(h + (ax.wheel.radius - deflection) / nz - hub.z);
     }
-    let clearance = 0.002 * spec.scale;
-    Ok(Pose { position: Vec3::new(x, y, z + clearance), orientation })
+    Ok(Pose {
+        position: Vec3::new(x, y, z),
+        orientation,
+    })
 }
 
 /// Static spring compression per axle: a rigid chassis on the axle springs (heave and pitch),
@@ -462,7 +527,11 @@ fn static_compressions(spec: &VehicleSpec) -> Vec<f64> {
     }
     // Solve [k0 k1; k1 k2] [z; θ] = [W; 0] with compression_i = z + θ·dx_i.
     let det = k0 * k2 - k1 * k1;
-    let (z, th) = if det.abs() > 1e-12 * k0 * k2.max(1e-12) { (w * k2 / det, -w * k1 / det) } else { (w / k0, 0.0) };
+    let (z, th) = if det.abs() > 1e-12 * k0 * k2.max(1e-12) {
+        (w * k2 / det, -w * k1 / det)
+    } else {
+        (w / k0, 0.0)
+    };
     spec.axles.iter().map(|ax| z + th * (ax.x - xc)).collect()
 }
 
@@ -470,25 +539,54 @@ impl Sim {
     /// Builds the immutable model of `spec` on `world` and remembers `start` for
     /// [`Sim::initial_state`].
     pub fn new(world: &Arc<World>, spec: &VehicleSpec, start: Pose) -> Result<Sim, SimError> {
-        spec.validate(&spec.name).map_err(|e| SimError::InvalidSetup(e.to_string()))?;
+        spec.validate(&spec.name)
+            .map_err(|e| SimError::InvalidSetup(e.to_string()))?;
         if !(start.position.is_finite() && start.orientation.is_finite()) {
-            return Err(SimError::InvalidStart("the start pose is not finite".into()));
+            return Err(SimError::InvalidStart(
+                "the start pose is not finite".into(),
+            ));
         }
-        let qn = (start.orientation.w.powi(2) + start.orientation.x.powi(2) + start.orientation.y.powi(2) + start.orientation.z.powi(2)).sqrt();
+        let qn = (start.orientation.w.powi(2)
+            + start.orientation.x.powi(2)
+            + start.orientation.y.powi(2)
+            + start.orientation.z.powi(2))
+        .sqrt();
         if (qn - 1.0).abs() > 1e-6 {
-            return Err(SimError::InvalidStart(format!("the start orientation is not a unit quaternion (norm {qn})")));
+            return Err(SimError::InvalidStart(format!(
+                "the start orientation is not a unit quaternion (norm {qn})"
+            )));
         }
         let scale = world.meta.scale;
         if !(scale.is_finite() && scale > 0.0) {
-            return Err(SimError::InvalidSetup(format!("world scale {scale} is not positive")));
+            return Err(SimError::InvalidSetup(format!(
+                "world scale {scale} is not positive"
+            )));
         }
-        let com = Vec3::new(spec.chassis.com[0], spec.chassis.com[1], spec.chassis.com[2]);
+        let com = Vec3::new(
+            spec.chassis.com[0],
+            spec.chassis.com[1],
+            spec.chassis.com[2],
+        );
         let track_mass = spec.track.map_or(0.0, |t| 2.0 * t.track_mass);
         let sprung_mass = spec.chassis.mass + track_mass;
-        let total_mass = sprung_mass + spec.axles.iter().map(|a| 2.0 * a.wheel.unsprung_mass).sum::<f64>();
+        let total_mass = sprung_mass
+            + spec
+                .axles
+                .iter()
+                .map(|a| 2.0 * a.wheel.unsprung_mass)
+                .sum::<f64>();
         let comp = static_compressions(spec);
-        let steered_x: Vec<f64> = spec.axles.iter().filter(|a| !a.steered).map(|a| a.x).collect();
-        let x_rear = if steered_x.is_empty() { 0.0 } else { steered_x.iter().sum::<f64>() / steered_x.len() as f64 };
+        let steered_x: Vec<f64> = spec
+            .axles
+            .iter()
+            .filter(|a| !a.steered)
+            .map(|a| a.x)
+            .collect();
+        let x_rear = if steered_x.is_empty() {
+            0.0
+        } else {
+            steered_x.iter().sum::<f64>() / steered_x.len() as f64
+        };
         let h = spec.internal_step;
 
         // Spin groups: tracks tie a side; locked differentials tie axles and sides.
@@ -499,12 +597,21 @@ impl Sim {
             for (j, side) in [1.0f64, -1.0].into_iter().enumerate() {
                 let w = 2 * k + j;
                 let key = group_key(spec, tracked, w);
-                let existing =
-                    key.and_then(|key| groups.iter().position(|g| group_key(spec, tracked, g.wheels[0]) == Some(key)));
+                let existing = key.and_then(|key| {
+                    groups
+                        .iter()
+                        .position(|g| group_key(spec, tracked, g.wheels[0]) == Some(key))
+                });
                 let g = match existing {
                     Some(g) => g,
                     None => {
-                        groups.push(SpinGroup { wheels: Vec::new(), inertia: 0.0, drive_share: 0.0, side, driven: false });
+                        groups.push(SpinGroup {
+                            wheels: Vec::new(),
+                            inertia: 0.0,
+                            drive_share: 0.0,
+                            side,
+                            driven: false,
+                        });
                         groups.len() - 1
                     }
                 };
@@ -521,19 +628,32 @@ impl Sim {
         if let Some(tr) = &spec.track {
             for g in &mut groups {
                 // the track's mass spins with its side at the road-wheel radius
-                let r = g.wheels.iter().map(|&w| spec.axles[w / 2].wheel.radius).sum::<f64>() / g.wheels.len() as f64;
+                let r = g
+                    .wheels
+                    .iter()
+                    .map(|&w| spec.axles[w / 2].wheel.radius)
+                    .sum::<f64>()
+                    / g.wheels.len() as f64;
                 g.inertia += tr.track_mass * r * r;
             }
         }
         let driven_wheels = spec.axles.iter().filter(|a| a.driven).count() * 2;
         for g in &mut groups {
-            let driven_members = g.wheels.iter().filter(|&&w| spec.axles[w / 2].driven).count();
+            let driven_members = g
+                .wheels
+                .iter()
+                .filter(|&&w| spec.axles[w / 2].driven)
+                .count();
             g.drive_share = driven_members as f64 / driven_wheels as f64;
             g.driven = driven_members > 0;
         }
 
         let mut wheels = Vec::with_capacity(spec.wheel_count());
-        let mut inertia = Vec3::new(spec.chassis.inertia[0], spec.chassis.inertia[1], spec.chassis.inertia[2]);
+        let mut inertia = Vec3::new(
+            spec.chassis.inertia[0],
+            spec.chassis.inertia[1],
+            spec.chassis.inertia[2],
+        );
         let mut reach: f64 = 0.0;
         let per_wheel_load = total_mass * GRAVITY / spec.wheel_count() as f64;
         for (k, ax) in spec.axles.iter().enumerate() {
@@ -553,7 +673,8 @@ impl Sim {
                 let k_long = t.dfx0 * per_wheel_load / t.relaxation_length;
                 let k_lat = t.dfy0 * per_wheel_load / t.relaxation_length;
                 let g = group_of[w];
-                let spin_mass = groups[g].inertia / groups[g].wheels.len() as f64 / ax.wheel.radius.powi(2);
+                let spin_mass =
+                    groups[g].inertia / groups[g].wheels.len() as f64 / ax.wheel.radius.powi(2);
                 let lat_mass = total_mass / spec.wheel_count() as f64;
                 let stop_damping = 2.0 * 0.5 * (ax.suspension.stop_stiffness * mu).sqrt();
                 wheels.push(WheelModel {
@@ -575,6 +696,7 @@ impl Sim {
                     group: g,
                     slip_damping_long: 0.6 * (k_long * spin_mass).sqrt(),
                     slip_damping_lat: 0.6 * (k_lat * lat_mass).sqrt(),
+                    nominal_load: per_wheel_load,
                     static_compression: comp[k],
                 });
             }
@@ -587,7 +709,8 @@ impl Sim {
         for iz in [-1.0, 1.0] {
             for ix in [-1.0, 0.0, 1.0] {
                 for iy in [-1.0, 0.0, 1.0] {
-                    let p = box_center + Vec3::new(ix * box_half.x, iy * box_half.y, iz * box_half.z);
+                    let p =
+                        box_center + Vec3::new(ix * box_half.x, iy * box_half.y, iz * box_half.z);
                     reach = reach.max(p.norm());
                     body_points.push(p);
                 }
@@ -603,7 +726,10 @@ impl Sim {
             let delta = SOIL_DELTA_FULL_SCALE * scale;
             let layout = SoilLayout::new(world.terrain.half_extent(), delta);
             if layout.chunks > 4096 {
-                return Err(SimError::InvalidSetup(format!("soil grid of {} chunks per side is too large", layout.chunks)));
+                return Err(SimError::InvalidSetup(format!(
+                    "soil grid of {} chunks per side is too large",
+                    layout.chunks
+                )));
             }
             Some(layout)
         } else {
@@ -621,7 +747,11 @@ impl Sim {
             groups,
             sprung_mass,
             total_mass,
-            chassis_inertia: Vec3::new(spec.chassis.inertia[0], spec.chassis.inertia[1], spec.chassis.inertia[2]),
+            chassis_inertia: Vec3::new(
+                spec.chassis.inertia[0],
+                spec.chassis.inertia[1],
+                spec.chassis.inertia[2],
+            ),
             inertia,
             com,
             body_points,
@@ -666,7 +796,8 @@ impl Sim {
 
     /// The state at the start pose, at rest.
     pub fn initial_state(&self) -> SimState {
-        self.state_at(self.start).expect("start pose validated in Sim::new")
+        self.state_at(self.start)
+            .expect("start pose validated in Sim::new")
     }
 
     /// A state at rest at `pose`, springs at their static compression.
@@ -705,7 +836,11 @@ impl Sim {
                         for _ in 0..40 {
                             let mid = 0.5 * (lo + hi);
                             let (cx, cy) = tmeasy_combined(mid * dir.0, mid * dir.1, t, 1.0);
-                            if cx.hypot(cy) < need { lo = mid } else { hi = mid }
+                            if cx.hypot(cy) < need {
+                                lo = mid
+                            } else {
+                                hi = mid
+                            }
                         }
                         kx = lo * dir.0;
                         ky = lo * dir.1;
@@ -740,7 +875,10 @@ impl Sim {
 
     /// Pose of the chassis reference frame (the frame the vehicle file is written in).
     pub fn reference_pose(&self, state: &SimState) -> Pose {
-        Pose { position: state.position - state.orientation.rotate(self.com), orientation: state.orientation }
+        Pose {
+            position: state.position - state.orientation.rotate(self.com),
+            orientation: state.orientation,
+        }
     }
 
     /// World position of a point given in the chassis reference frame.
@@ -753,7 +891,9 @@ impl Sim {
         self.wheels
             .iter()
             .zip(&state.wheels)
-            .map(|(m, w)| state.position + state.orientation.rotate(m.attach + Vec3::Z * w.compression))
+            .map(|(m, w)| {
+                state.position + state.orientation.rotate(m.attach + Vec3::Z * w.compression)
+            })
             .collect()
     }
 
@@ -825,14 +965,21 @@ impl Sim {
             self.substep(state, &controls, h);
             state.time = t0 + (k + 1) as f64 * h;
             // cheap guard so a blow-up cannot run away inside a long step
-            if !(state.position.x.abs() < 1e9 && state.position.y.abs() < 1e9 && state.position.z.abs() < 1e9) {
+            if !(state.position.x.abs() < 1e9
+                && state.position.y.abs() < 1e9
+                && state.position.z.abs() < 1e9)
+            {
                 break;
             }
         }
         // per-wheel steer angles are outputs only: computed once per call, not per internal step
         let turn_radius = self.turn_radius(state.steer);
         for (m, w) in self.wheels.iter().zip(state.wheels.iter_mut()) {
-            w.steer_angle = if m.steered && turn_radius.is_finite() { (m.ackermann_dx / (turn_radius - m.y)).atan() } else { 0.0 };
+            w.steer_angle = if m.steered && turn_radius.is_finite() {
+                (m.ackermann_dx / (turn_radius - m.y)).atan()
+            } else {
+                0.0
+            };
         }
         state.check(self.world.meta.scale)
     }
@@ -909,8 +1056,8 @@ impl Sim {
         let mut wheel_susp = [0.0; crate::spec::MAX_WHEELS];
         let mut wheel_k = [0.0; crate::spec::MAX_WHEELS];
         let mut wheel_c = [0.0; crate::spec::MAX_WHEELS];
-        let mut wheel_kc = [0.0; crate::spec::MAX_WHEELS];
-        let mut wheel_cc = [0.0; crate::spec::MAX_WHEELS];
+        let mut wheel_kc = [Vec3::ZERO; crate::spec::MAX_WHEELS];
+        let mut wheel_cc = [Vec3::ZERO; crate::spec::MAX_WHEELS];
         let mut group_torque = [0.0; crate::spec::MAX_WHEELS];
         let mut group_k = [0.0; crate::spec::MAX_WHEELS];
         let mut long_tyre = [LongTyre::default(); crate::spec::MAX_WHEELS];
@@ -942,7 +1089,8 @@ impl Sim {
                 k_extra += m.stop;
                 c_extra += m.stop_damping;
             } else if ws.compression < -m.rebound {
-                f_susp += m.stop * (ws.compression + m.rebound) + m.stop_damping * ws.compression_rate;
+                f_susp +=
+                    m.stop * (ws.compression + m.rebound) + m.stop_damping * ws.compression_rate;
                 k_extra += m.stop;
                 c_extra += m.stop_damping;
             }
@@ -971,7 +1119,7 @@ impl Sim {
                 vx = v_contact.dot(e_long);
                 vy = v_contact.dot(e_lat);
                 let (kx, ky) = (ws.slip_long, ws.slip_lat);
-                let (fx, fy, initial_slope, limit);
+                let (mut fx, mut fy, initial_slope, limit);
                 if contact.soil_load > contact.rigid_load {
                     // Janosi–Hanamoto traction over the soil patch, Mohr–Coulomb limit
                     let kn = (kx * kx + ky * ky).sqrt();
@@ -994,10 +1142,32 @@ impl Sim {
                     limit = spec.tyre.fxm.max(spec.tyre.fym) * contact.mu_scale * fz_total;
                     slip_clamp = -1.0; // rigid: direction-dependent clamp computed later
                 }
-                // Bristle damping fades out with speed (TMeasy blends its Dahl model the same way).
+                // At standstill the tyre is an elastic bristle of fixed stiffness (TMeasy's Dahl
+                // model): the force follows the deflection, not the momentary load, up to the
+                // friction limit. Making it proportional to the load there closes a fast loop
+                // (roll → load → lateral force → roll) that rocks a vehicle parked on a steep
+                // side slope. Above 1 m/s (scaled) the slip curve alone acts; in between blend.
                 let vref = vx.abs().max((spin * radius).abs());
                 let fade = (1.0 - vref / spec.scale.sqrt()).max(0.0);
-                let mut fy = fy - fade * m.slip_damping_lat * vy;
+                if fade > 0.0 {
+                    let (cx, cy) = if contact.soil_load > contact.rigid_load {
+                        (
+                            initial_slope / fz_total.max(1e-9),
+                            initial_slope / fz_total.max(1e-9),
+                        )
+                    } else {
+                        (spec.tyre.dfx0, spec.tyre.dfy0)
+                    };
+                    let (mut dx, mut dy) = (cx * m.nominal_load * kx, cy * m.nominal_load * ky);
+                    let dn = dx.hypot(dy);
+                    if dn > limit {
+                        dx *= limit / dn;
+                        dy *= limit / dn;
+                    }
+                    fx = fade * dx + (1.0 - fade) * fx;
+                    fy = fade * dy + (1.0 - fade) * fy;
+                }
+                fy -= fade * m.slip_damping_lat * vy;
                 fy = fy.clamp(-limit, limit);
                 lat_force = fy;
                 let f_lat = e_lat * fy;
@@ -1008,11 +1178,18 @@ impl Sim {
                 let m_contact = (n * (-radius)).cross(f_lat);
                 contact_moment = m_contact - axle * m_contact.dot(axle);
                 let vroll = spin * radius;
-                roll_torque = -spec.tyre.rolling_resistance * contact.rigid_load * radius * soft_sign(vroll / 0.1);
+                roll_torque = -spec.tyre.rolling_resistance
+                    * contact.rigid_load
+                    * radius
+                    * soft_sign(vroll / 0.1);
                 // Longitudinal force linearised in the new spin: F = C·κ_new − c·(vx − ω_new·R)
                 // with the secant stiffness C = F(κ)/κ (the initial slope near κ = 0) and
                 // κ_new = a + b·ω_new from the implicit relaxation update.
-                let secant = if kx.abs() > 1e-6 { (fx / kx).max(0.0) } else { initial_slope };
+                let secant = if kx.abs() > 1e-6 {
+                    (fx / kx).max(0.0)
+                } else {
+                    initial_slope
+                };
                 let decay = 1.0 + h * vref / spec.tyre.relaxation_length;
                 long = LongTyre {
                     active: true,
@@ -1033,8 +1210,10 @@ impl Sim {
             // the longitudinal tyre force enters the implicit spin solve below
             group_torque[m.group] += roll_torque + contact.soil_moment.dot(axle);
             if long.active {
-                group_k[m.group] += long.radius * (long.stiffness * long.b + long.damping * long.radius);
-                group_torque[m.group] -= long.radius * (long.stiffness * long.a - long.damping * long.vx);
+                group_k[m.group] +=
+                    long.radius * (long.stiffness * long.b + long.damping * long.radius);
+                group_torque[m.group] -=
+                    long.radius * (long.stiffness * long.a - long.damping * long.vx);
             }
 
             // composite-body force and torque
@@ -1051,8 +1230,8 @@ impl Sim {
             wheel_susp[w] = f_susp;
             wheel_k[w] = k_extra + contact.k_axis;
             wheel_c[w] = c_extra + contact.c_axis;
-            wheel_kc[w] = contact.k_axis;
-            wheel_cc[w] = contact.c_axis;
+            wheel_kc[w] = contact.k_vec;
+            wheel_cc[w] = contact.c_vec;
 
             let out = &mut st.wheels[w];
             out.normal_force = fz_total;
@@ -1084,7 +1263,8 @@ impl Sim {
                 // positive steering turns left: more torque right, brake the left (inner) side
                 share *= 1.0 - grp.side * st.steer;
                 if grp.side * st.steer > 0.0 {
-                    brake_max += spec.steering.skid_brake_torque * st.steer.abs() * grp.wheels.len() as f64;
+                    brake_max +=
+                        spec.steering.skid_brake_torque * st.steer.abs() * grp.wheels.len() as f64;
                 }
             }
             let drive = wheel_torque_total * share;
@@ -1098,7 +1278,10 @@ impl Sim {
             let (w1, brake_applied) = if x.abs() <= brake_max {
                 (0.0, -x)
             } else {
-                ((x - x.signum() * brake_max) / denom, -x.signum() * brake_max)
+                (
+                    (x - x.signum() * brake_max) / denom,
+                    -x.signum() * brake_max,
+                )
             };
             st.group_spin[g] = w1;
             group_reaction[g] = -(drive + brake_applied) / grp.wheels.len() as f64;
@@ -1111,7 +1294,9 @@ impl Sim {
                 continue;
             }
             let spin = st.group_spin[m.group];
-            let fx = (lt.stiffness * (lt.a + lt.b * spin) - lt.damping * (lt.vx - spin * lt.radius)).clamp(-lt.limit, lt.limit);
+            let fx = (lt.stiffness * (lt.a + lt.b * spin)
+                - lt.damping * (lt.vx - spin * lt.radius))
+                .clamp(-lt.limit, lt.limit);
             let f = lt.e_long * fx;
             let f_axis = f.dot(up);
             force += f;
@@ -1140,7 +1325,11 @@ impl Sim {
         let om = st.omega;
         let i = self.inertia;
         let gyro = om.cross(Vec3::new(i.x * om.x, i.y * om.y, i.z * om.z));
-        let alpha_body = Vec3::new((tb.x - gyro.x) / i.x, (tb.y - gyro.y) / i.y, (tb.z - gyro.z) / i.z);
+        let alpha_body = Vec3::new(
+            (tb.x - gyro.x) / i.x,
+            (tb.y - gyro.y) / i.y,
+            (tb.z - gyro.z) / i.z,
+        );
         let alpha = q.rotate(alpha_body);
 
         // ---- wheels: implicit suspension update ----
@@ -1152,11 +1341,14 @@ impl Sim {
         for w in 0..nw {
             let m = &self.wheels[w];
             let r = wheel_arm[w];
-            let a_attach = (accel + alpha.cross(r) + omega_w.cross(omega_w.cross(r))).dot(up);
-            let v_attach_new = (st.velocity + omega_w.cross(r)).dot(up) + h * a_attach;
-            let f0 = wheel_axis_force[w] - wheel_susp[w] - m.unsprung_mass * a_attach
-                - wheel_kc[w] * h * v_attach_new
-                - wheel_cc[w] * h * a_attach;
+            let a_attach_vec = accel + alpha.cross(r) + omega_w.cross(omega_w.cross(r));
+            let a_attach = a_attach_vec.dot(up);
+            let v_attach_new = st.velocity + omega_w.cross(r) + a_attach_vec * h;
+            let f0 = wheel_axis_force[w]
+                - wheel_susp[w]
+                - m.unsprung_mass * a_attach
+                - h * wheel_kc[w].dot(v_attach_new)
+                - h * wheel_cc[w].dot(a_attach_vec);
             let ws = &mut st.wheels[w];
             let mc = m.unsprung_mass + h * wheel_c[w];
             let rate = (mc * ws.compression_rate + h * f0) / (mc + h * h * wheel_k[w]);
@@ -1182,7 +1374,11 @@ impl Sim {
             let decay = 1.0 + h * vref / sigma;
             let mut kx = (ws.slip_long - h * vslip / sigma) / decay;
             let mut ky = (ws.slip_lat - h * vy / sigma) / decay;
-            let limit = if clamp < 0.0 { tmeasy_sliding_slip(kx, ky, &spec.tyre) } else { clamp };
+            let limit = if clamp < 0.0 {
+                tmeasy_sliding_slip(kx, ky, &spec.tyre)
+            } else {
+                clamp
+            };
             let kn = (kx * kx + ky * ky).sqrt();
             if kn > limit {
                 kx *= limit / kn;
@@ -1202,7 +1398,10 @@ impl Sim {
 
     /// Distance from the steered reference (first steered axle) to the unsteered axles.
     fn wheels_base_length(&self) -> f64 {
-        self.wheels.iter().find(|w| w.steered).map_or(1.0, |w| w.ackermann_dx)
+        self.wheels
+            .iter()
+            .find(|w| w.steered)
+            .map_or(1.0, |w| w.ackermann_dx)
     }
 
     /// Contact of one wheel with rigid terrain, obstacles and soil.
@@ -1231,10 +1430,16 @@ impl Sim {
         let down = {
             let d = Vec3::new(0.0, 0.0, -1.0) - axle * (-axle.z);
             let n = d.norm();
-            if n > 1e-6 { d / n } else { Vec3::new(0.0, 0.0, -1.0) }
+            if n > 1e-6 {
+                d / n
+            } else {
+                Vec3::new(0.0, 0.0, -1.0)
+            }
         };
         let lowest_z = hub.z + r * down.z - m.half_width * axle.z.abs();
-        let ground_max = self.bound.max_in(hub.x - r, hub.y - r, hub.x + r, hub.y + r);
+        let ground_max = self
+            .bound
+            .max_in(hub.x - r, hub.y - r, hub.x + r, hub.y + r);
         let near_ground = lowest_z < ground_max;
 
         let mut best_depth = 0.0;
@@ -1272,7 +1477,9 @@ impl Sim {
                 let mu = match patches[ground.patch_index(p.x, p.y)].surface {
                     Surface::Rigid { friction, .. } => friction,
                     // beyond the map edge there are no soil nodes: the ground acts rigid there
-                    Surface::Deformable { soil } if !hf.contains(p.x, p.y) => soil.friction_angle_deg.to_radians().tan(),
+                    Surface::Deformable { soil } if !hf.contains(p.x, p.y) => {
+                        soil.friction_angle_deg.to_radians().tan()
+                    }
                     Surface::Deformable { .. } => {
                         soil_here = true;
                         continue;
@@ -1288,7 +1495,9 @@ impl Sim {
             }
             if !soil_here && self.soil.is_some() {
                 // the wheel may be sunk in soil with its rim samples above the undeformed level
-                soil_here = patches[ground.patch_index(hub.x, hub.y)].surface.is_deformable();
+                soil_here = patches[ground.patch_index(hub.x, hub.y)]
+                    .surface
+                    .is_deformable();
             }
         }
         let k_t = tyre.radial_stiffness;
@@ -1309,7 +1518,10 @@ impl Sim {
             c.force += n * f;
             c.k_axis += k * nu * nu;
             c.c_axis += c_t * nu * nu;
-            c.mu_scale = (c.mu_scale * c.rigid_load + (mu.min(tyre.friction) / tyre.friction) * f) / (c.rigid_load + f);
+            c.k_vec += n * (k * nu);
+            c.c_vec += n * (c_t * nu);
+            c.mu_scale = (c.mu_scale * c.rigid_load + (mu.min(tyre.friction) / tyre.friction) * f)
+                / (c.rigid_load + f);
             c.rigid_load += f;
             c.depth = c.depth.max(depth);
         };
@@ -1379,7 +1591,9 @@ impl Sim {
         let delta = layout.delta;
         let area = delta * delta;
         // Footprint bound: the part of the wheel below the highest undeformed level nearby.
-        let ground_max = self.bound.max_in(hub.x - r, hub.y - r, hub.x + r, hub.y + r);
+        let ground_max = self
+            .bound
+            .max_in(hub.x - r, hub.y - r, hub.x + r, hub.y + r);
         let drop = hub.z - ground_max;
         if drop >= r {
             return;
@@ -1392,7 +1606,8 @@ impl Sim {
         let i1 = fast_floor((hub.x + ext_x) / delta);
         let j0 = fast_ceil((hub.y - ext_y) / delta);
         let j1 = fast_floor((hub.y + ext_y) / delta);
-        if i1 < i0 || j1 < j0 || ((i1 - i0 + 1) * (j1 - j0 + 1)) as usize > MAX_SOIL_NODES_PER_WHEEL {
+        if i1 < i0 || j1 < j0 || ((i1 - i0 + 1) * (j1 - j0 + 1)) as usize > MAX_SOIL_NODES_PER_WHEEL
+        {
             return;
         }
         // Vertical ray vs cylinder: |f + t·e|² = r², e = Z − (Z·a)a, f = w − (w·a)a.
@@ -1431,12 +1646,18 @@ impl Sim {
                 if pk != cached_patch {
                     cached_patch = pk;
                     cached_soil = match patches[pk].surface {
-                        Surface::Deformable { soil } => Some((soil, soil.friction_angle_deg.to_radians().tan())),
+                        Surface::Deformable { soil } => {
+                            Some((soil, soil.friction_angle_deg.to_radians().tan()))
+                        }
                         Surface::Rigid { .. } => None,
                     };
                 }
-                let Some((soil, tan_phi)) = cached_soil else { continue };
-                let Some(at) = layout.locate(i, j) else { continue };
+                let Some((soil, tan_phi)) = cached_soil else {
+                    continue;
+                };
+                let Some(at) = layout.locate(i, j) else {
+                    continue;
+                };
                 let (z0, gx, gy) = ground.sample(x, y);
                 let ca = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
                 let sinkage = ca * (z0 - t);
@@ -1468,6 +1689,8 @@ impl Sim {
                 let nu = normal.dot(up);
                 c.k_axis += slope * area * nu * nu;
                 c.c_axis += soil.damping * area * nu * nu;
+                c.k_vec += normal * (slope * area * nu);
+                c.c_vec += normal * (soil.damping * area * nu);
                 let s_pos = sigma.max(0.0);
                 let tau_max = soil.cohesion + s_pos * tan_phi;
                 shear_limit += tau_max * area;
@@ -1489,7 +1712,11 @@ impl Sim {
             c.soil_load += load.max(0.0);
             c.soil_shear_limit += shear_limit;
             c.soil_length = length;
-            c.soil_janosi_k = if load.abs() > 0.0 { janosi_weighted / load.abs().max(1e-9) } else { 0.01 };
+            c.soil_janosi_k = if load.abs() > 0.0 {
+                janosi_weighted / load.abs().max(1e-9)
+            } else {
+                0.01
+            };
             // b = 2A/L of the patch (rectangle of the hit extents) for Bekker's K_c/b next time
             let a_patch = f64::from(c.soil_nodes) * area;
             let perimeter = 2.0 * (length + width);
@@ -1500,7 +1727,14 @@ impl Sim {
     /// Chassis collision box against terrain (rigid, or the undeformed soil surface) and
     /// obstacles: compliant normal force plus regularised Coulomb friction.
     #[inline(never)]
-    fn body_contacts(&self, st: &SimState, near: &[u32], force: &mut Vec3, torque: &mut Vec3, contacts: &mut ContactInfo) {
+    fn body_contacts(
+        &self,
+        st: &SimState,
+        near: &[u32],
+        force: &mut Vec3,
+        torque: &mut Vec3,
+        contacts: &mut ContactInfo,
+    ) {
         let world = &*self.world;
         let q = st.orientation;
         let omega_w = q.rotate(st.omega);
@@ -1528,7 +1762,11 @@ impl Sim {
             }
             let vt = v - n * vn;
             let vtn = vt.norm();
-            let ft = if vtn > 0.0 { vt * (-mu * fnorm / vtn.max(self.friction_speed)) } else { Vec3::ZERO };
+            let ft = if vtn > 0.0 {
+                vt * (-mu * fnorm / vtn.max(self.friction_speed))
+            } else {
+                Vec3::ZERO
+            };
             let f = n * fnorm + ft;
             *force += f;
             *torque += arm.cross(f);
@@ -1548,7 +1786,9 @@ impl Sim {
                 let n = Vec3::new(-gx * nz, -gy * nz, nz);
                 let mu = match patches[self.ground.patch_index(p.x, p.y)].surface {
                     Surface::Rigid { friction, .. } => friction.min(mu_body),
-                    Surface::Deformable { soil } => soil.friction_angle_deg.to_radians().tan().min(mu_body),
+                    Surface::Deformable { soil } => {
+                        soil.friction_angle_deg.to_radians().tan().min(mu_body)
+                    }
                 };
                 if apply(*p, n, (h - p.z) * nz, mu) {
                     contacts.chassis_terrain_points += 1;
@@ -1631,8 +1871,20 @@ fn fast_ceil(x: f64) -> i64 {
 #[inline]
 fn integrate_orientation(q: Quat, omega: Vec3, h: f64) -> Quat {
     let k = 0.5 * h;
-    let dq = Quat { w: 0.0, x: omega.x * k, y: omega.y * k, z: omega.z * k }.mul(q);
-    Quat { w: q.w + dq.w, x: q.x + dq.x, y: q.y + dq.y, z: q.z + dq.z }.normalized()
+    let dq = Quat {
+        w: 0.0,
+        x: omega.x * k,
+        y: omega.y * k,
+        z: omega.z * k,
+    }
+    .mul(q);
+    Quat {
+        w: q.w + dq.w,
+        x: q.x + dq.x,
+        y: q.y + dq.y,
+        z: q.z + dq.z,
+    }
+    .normalized()
 }
 
 /// Key identifying which spin group a wheel joins (None = its own group).
@@ -1645,7 +1897,10 @@ fn group_key(spec: &VehicleSpec, tracked: bool, w: usize) -> Option<usize> {
     if !ax.driven {
         return None;
     }
-    match (spec.powertrain.axle_differential, spec.powertrain.central_differential) {
+    match (
+        spec.powertrain.axle_differential,
+        spec.powertrain.central_differential,
+    ) {
         (Differential::Locked, Differential::Locked) => Some(100),
         (Differential::Locked, Differential::Open) => Some(200 + w / 2),
         _ => None,

@@ -29,7 +29,10 @@ pub struct Chunk {
 
 impl Default for Chunk {
     fn default() -> Self {
-        Chunk { plastic: [0.0; CHUNK_NODES], yield_pressure: [0.0; CHUNK_NODES] }
+        Chunk {
+            plastic: [0.0; CHUNK_NODES],
+            yield_pressure: [0.0; CHUNK_NODES],
+        }
     }
 }
 
@@ -48,7 +51,11 @@ impl SoilLayout {
     pub fn new(half_extent: f64, delta: f64) -> SoilLayout {
         let half = (half_extent / delta).ceil() as i64;
         let nodes = (2 * half + 1) as usize;
-        SoilLayout { delta, half, chunks: nodes.div_ceil(CHUNK) }
+        SoilLayout {
+            delta,
+            half,
+            chunks: nodes.div_ceil(CHUNK),
+        }
     }
 
     /// (chunk index, index inside the chunk) of node (i, j), or None off the grid.
@@ -60,7 +67,10 @@ impl SoilLayout {
             return None;
         }
         let (a, b) = (a as usize, b as usize);
-        Some(((b / CHUNK) * self.chunks + a / CHUNK, (b % CHUNK) * CHUNK + a % CHUNK))
+        Some((
+            (b / CHUNK) * self.chunks + a / CHUNK,
+            (b % CHUNK) * CHUNK + a % CHUNK,
+        ))
     }
 }
 
@@ -73,14 +83,19 @@ pub struct SoilState {
 impl SoilState {
     pub fn new(layout: Option<&SoilLayout>) -> SoilState {
         let n = layout.map_or(0, |l| l.chunks * l.chunks);
-        SoilState { table: Arc::new(vec![None; n]) }
+        SoilState {
+            table: Arc::new(vec![None; n]),
+        }
     }
 
     /// (plastic sinkage, yield pressure) of a node; untouched nodes read zero.
     #[inline]
     pub fn node(&self, at: (usize, usize)) -> (f64, f64) {
         match &self.table[at.0] {
-            Some(c) => (f64::from(c.plastic[at.1]), f64::from(c.yield_pressure[at.1])),
+            Some(c) => (
+                f64::from(c.plastic[at.1]),
+                f64::from(c.yield_pressure[at.1]),
+            ),
             None => (0.0, 0.0),
         }
     }
@@ -101,7 +116,11 @@ impl SoilState {
 
     /// Number of nodes with non-zero plastic sinkage.
     pub fn deformed_nodes(&self) -> usize {
-        self.table.iter().flatten().map(|c| c.plastic.iter().filter(|p| **p != 0.0).count()).sum()
+        self.table
+            .iter()
+            .flatten()
+            .map(|c| c.plastic.iter().filter(|p| **p != 0.0).count())
+            .sum()
     }
 
     /// Largest plastic sinkage anywhere [m].

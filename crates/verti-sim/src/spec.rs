@@ -213,7 +213,10 @@ impl VehicleSpec {
     /// Reads a user vehicle file.
     pub fn from_file(path: impl AsRef<Path>) -> Result<VehicleSpec, SpecError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| SpecError::Io { path: path.to_path_buf(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| SpecError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
         Self::from_yaml_str(&text, &path.display().to_string())
     }
 
@@ -233,7 +236,12 @@ impl VehicleSpec {
 
     /// Total mass: sprung + unsprung (+ tracks, which are part of the sprung mass).
     pub fn total_mass(&self) -> f64 {
-        self.chassis.mass + self.axles.iter().map(|a| 2.0 * a.wheel.unsprung_mass).sum::<f64>()
+        self.chassis.mass
+            + self
+                .axles
+                .iter()
+                .map(|a| 2.0 * a.wheel.unsprung_mass)
+                .sum::<f64>()
     }
 
     /// Distance from the first to the last axle.
@@ -245,23 +253,37 @@ impl VehicleSpec {
 
     /// Checks every field; the error names the first bad field.
     pub fn validate(&self, origin: &str) -> Result<(), SpecError> {
-        let bad = |field: String, problem: String| SpecError::Invalid { origin: origin.to_string(), field, problem };
+        let bad = |field: String, problem: String| SpecError::Invalid {
+            origin: origin.to_string(),
+            field,
+            problem,
+        };
         let pos = |field: &str, v: f64| -> Result<(), SpecError> {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(bad(field.to_string(), format!("{v} must be a positive finite number")))
+                Err(bad(
+                    field.to_string(),
+                    format!("{v} must be a positive finite number"),
+                ))
             }
         };
         let nonneg = |field: &str, v: f64| -> Result<(), SpecError> {
             if v.is_finite() && v >= 0.0 {
                 Ok(())
             } else {
-                Err(bad(field.to_string(), format!("{v} must be a finite number >= 0")))
+                Err(bad(
+                    field.to_string(),
+                    format!("{v} must be a finite number >= 0"),
+                ))
             }
         };
         let finite = |field: &str, v: f64| -> Result<(), SpecError> {
-            if v.is_finite() { Ok(()) } else { Err(bad(field.to_string(), format!("{v} must be finite"))) }
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(bad(field.to_string(), format!("{v} must be finite")))
+            }
         };
         if self.name.trim().is_empty() {
             return Err(bad("name".into(), "must not be empty".into()));
@@ -269,7 +291,10 @@ impl VehicleSpec {
         pos("scale", self.scale)?;
         pos("internal_step", self.internal_step)?;
         if self.internal_step > 0.01 {
-            return Err(bad("internal_step".into(), format!("{} s is too coarse (max 0.01 s)", self.internal_step)));
+            return Err(bad(
+                "internal_step".into(),
+                format!("{} s is too coarse (max 0.01 s)", self.internal_step),
+            ));
         }
         let c = &self.chassis;
         pos("chassis.mass", c.mass)?;
@@ -278,21 +303,39 @@ impl VehicleSpec {
         }
         let [a, b, cc] = c.inertia;
         if a + b < cc || a + cc < b || b + cc < a {
-            return Err(bad("chassis.inertia".into(), "violates the triangle inequality of a rigid body".into()));
+            return Err(bad(
+                "chassis.inertia".into(),
+                "violates the triangle inequality of a rigid body".into(),
+            ));
         }
         for (i, v) in c.com.iter().enumerate() {
             finite(&format!("chassis.com[{i}]"), *v)?;
         }
         for i in 0..3 {
-            finite(&format!("chassis.collision_box.center[{i}]"), c.collision_box.center[i])?;
-            pos(&format!("chassis.collision_box.size[{i}]"), c.collision_box.size[i])?;
+            finite(
+                &format!("chassis.collision_box.center[{i}]"),
+                c.collision_box.center[i],
+            )?;
+            pos(
+                &format!("chassis.collision_box.size[{i}]"),
+                c.collision_box.size[i],
+            )?;
         }
         nonneg("chassis.friction", c.friction)?;
         if self.axles.is_empty() {
-            return Err(bad("axles".into(), "a vehicle needs at least one axle".into()));
+            return Err(bad(
+                "axles".into(),
+                "a vehicle needs at least one axle".into(),
+            ));
         }
         if self.wheel_count() > MAX_WHEELS {
-            return Err(bad("axles".into(), format!("{} wheels; at most {MAX_WHEELS} are supported", self.wheel_count())));
+            return Err(bad(
+                "axles".into(),
+                format!(
+                    "{} wheels; at most {MAX_WHEELS} are supported",
+                    self.wheel_count()
+                ),
+            ));
         }
         for (i, ax) in self.axles.iter().enumerate() {
             let f = |name: &str| format!("axles[{i}].{name}");
@@ -311,12 +354,21 @@ impl VehicleSpec {
             pos(&f("wheel.width"), w.width)?;
             pos(&f("wheel.rim_radius"), w.rim_radius)?;
             if w.rim_radius >= w.radius {
-                return Err(bad(f("wheel.rim_radius"), format!("{} must be smaller than the radius {}", w.rim_radius, w.radius)));
+                return Err(bad(
+                    f("wheel.rim_radius"),
+                    format!(
+                        "{} must be smaller than the radius {}",
+                        w.rim_radius, w.radius
+                    ),
+                ));
             }
             pos(&f("wheel.unsprung_mass"), w.unsprung_mass)?;
             pos(&f("wheel.spin_inertia"), w.spin_inertia)?;
             if i > 0 && ax.x >= self.axles[i - 1].x {
-                return Err(bad(f("x"), "axles must be listed from front to rear (decreasing x)".into()));
+                return Err(bad(
+                    f("x"),
+                    "axles must be listed from front to rear (decreasing x)".into(),
+                ));
             }
         }
         if !self.axles.iter().any(|a| a.driven) {
@@ -338,7 +390,13 @@ impl VehicleSpec {
             pos(&format!("tyre.f{name}s"), fs)?;
             pos(&format!("tyre.s{name}s"), ss)?;
             if df0 * sm <= fm {
-                return Err(bad(format!("tyre.df{name}0"), format!("initial slope {df0} must exceed f{name}m / s{name}m = {}", fm / sm)));
+                return Err(bad(
+                    format!("tyre.df{name}0"),
+                    format!(
+                        "initial slope {df0} must exceed f{name}m / s{name}m = {}",
+                        fm / sm
+                    ),
+                ));
             }
             if ss <= sm || fs > fm {
                 return Err(bad(format!("tyre.s{name}s"), "sliding slip must exceed the peak slip and sliding force must not exceed the peak".into()));
@@ -347,57 +405,93 @@ impl VehicleSpec {
         let st = &self.steering;
         match st.kind {
             SteeringKind::Ackermann => {
-                if !(st.max_angle_deg.is_finite() && st.max_angle_deg > 0.0 && st.max_angle_deg < 80.0) {
-                    return Err(bad("steering.max_angle_deg".into(), format!("{} must be in (0, 80)", st.max_angle_deg)));
+                if !(st.max_angle_deg.is_finite()
+                    && st.max_angle_deg > 0.0
+                    && st.max_angle_deg < 80.0)
+                {
+                    return Err(bad(
+                        "steering.max_angle_deg".into(),
+                        format!("{} must be in (0, 80)", st.max_angle_deg),
+                    ));
                 }
                 pos("steering.rate_deg_per_s", st.rate_deg_per_s)?;
                 if !self.axles.iter().any(|a| a.steered) {
-                    return Err(bad("axles".into(), "Ackermann steering needs a steered axle".into()));
+                    return Err(bad(
+                        "axles".into(),
+                        "Ackermann steering needs a steered axle".into(),
+                    ));
                 }
                 if self.axles.iter().all(|a| a.steered) {
-                    return Err(bad("axles".into(), "Ackermann steering needs at least one unsteered axle".into()));
+                    return Err(bad(
+                        "axles".into(),
+                        "Ackermann steering needs at least one unsteered axle".into(),
+                    ));
                 }
             }
             SteeringKind::Skid => {
                 nonneg("steering.skid_brake_torque", st.skid_brake_torque)?;
                 if self.axles.iter().any(|a| a.steered) {
-                    return Err(bad("axles".into(), "skid-steered vehicles have no steered axles".into()));
+                    return Err(bad(
+                        "axles".into(),
+                        "skid-steered vehicles have no steered axles".into(),
+                    ));
                 }
             }
         }
         let p = &self.powertrain;
         pos("powertrain.max_speed_rpm", p.max_speed_rpm)?;
-        for (name, map) in [("full_throttle", &p.full_throttle), ("zero_throttle", &p.zero_throttle)] {
+        for (name, map) in [
+            ("full_throttle", &p.full_throttle),
+            ("zero_throttle", &p.zero_throttle),
+        ] {
             if map.len() < 2 {
-                return Err(bad(format!("powertrain.{name}"), "a map needs at least two points".into()));
+                return Err(bad(
+                    format!("powertrain.{name}"),
+                    "a map needs at least two points".into(),
+                ));
             }
             for (k, pt) in map.iter().enumerate() {
                 finite(&format!("powertrain.{name}[{k}][0]"), pt[0])?;
                 finite(&format!("powertrain.{name}[{k}][1]"), pt[1])?;
                 if k > 0 && pt[0] <= map[k - 1][0] {
-                    return Err(bad(format!("powertrain.{name}[{k}]"), "speeds must increase".into()));
+                    return Err(bad(
+                        format!("powertrain.{name}[{k}]"),
+                        "speeds must increase".into(),
+                    ));
                 }
             }
         }
         if p.gears.is_empty() {
-            return Err(bad("powertrain.gears".into(), "needs at least one gear".into()));
+            return Err(bad(
+                "powertrain.gears".into(),
+                "needs at least one gear".into(),
+            ));
         }
         for (k, g) in p.gears.iter().enumerate() {
             pos(&format!("powertrain.gears[{k}]"), *g)?;
             if k > 0 && *g <= p.gears[k - 1] {
-                return Err(bad(format!("powertrain.gears[{k}]"), "gear ratios must increase".into()));
+                return Err(bad(
+                    format!("powertrain.gears[{k}]"),
+                    "gear ratios must increase".into(),
+                ));
             }
         }
         pos("powertrain.upshift_rpm", p.upshift_rpm)?;
         nonneg("powertrain.downshift_rpm", p.downshift_rpm)?;
         if p.gears.len() > 1 && p.downshift_rpm * p.gears[1] / p.gears[0] >= p.upshift_rpm {
-            return Err(bad("powertrain.downshift_rpm".into(), "shift bands overlap: an upshift would immediately downshift".into()));
+            return Err(bad(
+                "powertrain.downshift_rpm".into(),
+                "shift bands overlap: an upshift would immediately downshift".into(),
+            ));
         }
         pos("powertrain.final_drive", p.final_drive)?;
         if let Some(tr) = &self.track {
             nonneg("track.track_mass", tr.track_mass)?;
             if st.kind != SteeringKind::Skid {
-                return Err(bad("steering.kind".into(), "a tracked vehicle must use skid steering".into()));
+                return Err(bad(
+                    "steering.kind".into(),
+                    "a tracked vehicle must use skid steering".into(),
+                ));
             }
         }
         Ok(())
@@ -407,7 +501,11 @@ impl VehicleSpec {
     pub fn summary(&self) -> String {
         let mut s = String::new();
         let _ = writeln!(s, "{} — {}", self.name, self.description);
-        let _ = writeln!(s, "  scale            {}", verti_world::scale::scale_label(self.scale));
+        let _ = writeln!(
+            s,
+            "  scale            {}",
+            verti_world::scale::scale_label(self.scale)
+        );
         let _ = writeln!(
             s,
             "  mass             {:.2} kg total ({:.2} kg sprung), inertia {:?} kg m²",
@@ -415,7 +513,18 @@ impl VehicleSpec {
             self.chassis.mass,
             self.chassis.inertia
         );
-        let _ = writeln!(s, "  wheelbase        {:.3} m, {} axles, {} wheels{}", self.wheelbase(), self.axles.len(), self.wheel_count(), if self.is_tracked() { " (road wheels on tracks)" } else { "" });
+        let _ = writeln!(
+            s,
+            "  wheelbase        {:.3} m, {} axles, {} wheels{}",
+            self.wheelbase(),
+            self.axles.len(),
+            self.wheel_count(),
+            if self.is_tracked() {
+                " (road wheels on tracks)"
+            } else {
+                ""
+            }
+        );
         for (i, a) in self.axles.iter().enumerate() {
             let _ = writeln!(
                 s,
@@ -432,20 +541,41 @@ impl VehicleSpec {
         }
         match self.steering.kind {
             SteeringKind::Ackermann => {
-                let _ = writeln!(s, "  steering         Ackermann, max {:.1}°, {:.0}°/s", self.steering.max_angle_deg, self.steering.rate_deg_per_s);
+                let _ = writeln!(
+                    s,
+                    "  steering         Ackermann, max {:.1}°, {:.0}°/s",
+                    self.steering.max_angle_deg, self.steering.rate_deg_per_s
+                );
             }
             SteeringKind::Skid => {
-                let _ = writeln!(s, "  steering         skid, inner-side brake {:.0} N m per wheel", self.steering.skid_brake_torque);
+                let _ = writeln!(
+                    s,
+                    "  steering         skid, inner-side brake {:.0} N m per wheel",
+                    self.steering.skid_brake_torque
+                );
             }
         }
         let p = &self.powertrain;
-        let peak = p.full_throttle.iter().map(|pt| pt[1]).fold(f64::NEG_INFINITY, f64::max);
+        let peak = p
+            .full_throttle
+            .iter()
+            .map(|pt| pt[1])
+            .fold(f64::NEG_INFINITY, f64::max);
         let _ = writeln!(
             s,
             "  powertrain       peak {:.1} N m, max {:.0} rpm, gears {:?}, final drive {}, differentials axle {:?} / central {:?}",
-            peak, p.max_speed_rpm, p.gears, p.final_drive, p.axle_differential, p.central_differential
+            peak,
+            p.max_speed_rpm,
+            p.gears,
+            p.final_drive,
+            p.axle_differential,
+            p.central_differential
         );
-        let _ = writeln!(s, "  tyre             μ {}, Cz {:.3e} N/m, rolling resistance {}", self.tyre.friction, self.tyre.radial_stiffness, self.tyre.rolling_resistance);
+        let _ = writeln!(
+            s,
+            "  tyre             μ {}, Cz {:.3e} N/m, rolling resistance {}",
+            self.tyre.friction, self.tyre.radial_stiffness, self.tyre.rolling_resistance
+        );
         let _ = write!(s, "  internal step    {} ms", self.internal_step * 1e3);
         s
     }

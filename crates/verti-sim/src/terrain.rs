@@ -34,7 +34,12 @@ impl HeightBound {
                 max[br * blocks + bc] = m;
             }
         }
-        HeightBound { blocks, inv_block: 1.0 / (BLOCK_CELLS as f64 * hf.cell()), half_extent: hf.half_extent(), max }
+        HeightBound {
+            blocks,
+            inv_block: 1.0 / (BLOCK_CELLS as f64 * hf.cell()),
+            half_extent: hf.half_extent(),
+            max,
+        }
     }
 
     /// Block (row, col) of a world point, clamped to the map (off-map points read the edge,
@@ -114,7 +119,13 @@ impl ObstacleGrid {
             items.extend_from_slice(l);
         }
         starts.push(items.len() as u32);
-        ObstacleGrid { cells, cell, origin, starts, items }
+        ObstacleGrid {
+            cells,
+            cell,
+            origin,
+            starts,
+            items,
+        }
     }
 
     /// Indices of the obstacles near (x, y); empty off the grid.
@@ -163,7 +174,9 @@ impl Ground {
             max_index: (n - 1) as f64,
             heights: hf.heights().to_vec(),
             patch_inv: 1.0 / world.patches.patch_size(),
-            patch_half: 0.5 * verti_world::surface::PATCHES_PER_SIDE as f64 * world.patches.patch_size(),
+            patch_half: 0.5
+                * verti_world::surface::PATCHES_PER_SIDE as f64
+                * world.patches.patch_size(),
         }
     }
 
@@ -192,11 +205,19 @@ impl Ground {
         if u >= v {
             let dx = se - sw;
             let dy = ne - se;
-            (sw + u * dx + v * dy, dx * self.inv_cell * keep_x, dy * self.inv_cell * keep_y)
+            (
+                sw + u * dx + v * dy,
+                dx * self.inv_cell * keep_x,
+                dy * self.inv_cell * keep_y,
+            )
         } else {
             let dy = nw - sw;
             let dx = ne - nw;
-            (sw + v * dy + u * dx, dx * self.inv_cell * keep_x, dy * self.inv_cell * keep_y)
+            (
+                sw + v * dy + u * dx,
+                dx * self.inv_cell * keep_x,
+                dy * self.inv_cell * keep_y,
+            )
         }
     }
 
@@ -223,7 +244,9 @@ mod tests {
             let (x, y) = (rng.range(-64.0, 64.0), rng.range(-64.0, 64.0));
             let a = g.sample(x, y);
             let b = w.terrain.sample(x, y);
-            assert!((a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9 && (a.2 - b.2).abs() < 1e-9);
+            assert!(
+                (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9 && (a.2 - b.2).abs() < 1e-9
+            );
             let (r, c) = w.patches.index_at(x, y);
             assert_eq!(g.patch_index(x, y), r * 16 + c);
         }

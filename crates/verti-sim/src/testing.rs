@@ -6,8 +6,8 @@ use verti_core::{Rng, Vec3};
 use verti_world::obstacle::box_faces;
 use verti_world::surface::{PATCHES_PER_SIDE, RIGID_RESTITUTION};
 use verti_world::{
-    ElevationLevel, Heightfield, Obstacle, ObstacleDensity, Patch, PatchGrid, SoilParams, Surface, TerrainClass,
-    TerrainType, World, WorldMeta, WorldSource,
+    ElevationLevel, Heightfield, Obstacle, ObstacleDensity, Patch, PatchGrid, SoilParams, Surface,
+    TerrainClass, TerrainType, World, WorldMeta, WorldSource,
 };
 
 /// Vertices per side of every test world.
@@ -15,7 +15,13 @@ pub const TEST_WORLD_VERTICES: usize = 129;
 
 /// A rigid patch of the given friction.
 pub fn rigid_patch(friction: f64) -> Patch {
-    Patch { class: TerrainClass::Concrete, surface: Surface::Rigid { friction, restitution: RIGID_RESTITUTION } }
+    Patch {
+        class: TerrainClass::Concrete,
+        surface: Surface::Rigid {
+            friction,
+            restitution: RIGID_RESTITUTION,
+        },
+    }
 }
 
 /// A deformable patch of the given soil.
@@ -27,7 +33,10 @@ pub fn soil_patch(soil: SoilParams) -> Patch {
     } else {
         TerrainClass::Mud
     };
-    Patch { class, surface: Surface::Deformable { soil } }
+    Patch {
+        class,
+        surface: Surface::Deformable { soil },
+    }
 }
 
 /// Builds a world from a height function of world (x, y), uniform patches and obstacles.
@@ -62,7 +71,10 @@ pub fn world_from_fn(
         meta: WorldMeta {
             name: format!("test/{name}"),
             index: 0,
-            source: WorldSource::Generated { set_seed: 0, generator: "test".into() },
+            source: WorldSource::Generated {
+                set_seed: 0,
+                generator: "test".into(),
+            },
             level: ElevationLevel::Low,
             terrain_type,
             density: ObstacleDensity::Sparse,
@@ -84,19 +96,37 @@ fn uniform(p: Patch) -> Vec<Patch> {
 
 /// Flat rigid ground at z = 0.
 pub fn flat_world(scale: f64, friction: f64) -> World {
-    world_from_fn("flat", scale, |_, _| 0.0, uniform(rigid_patch(friction)), Vec::new())
+    world_from_fn(
+        "flat",
+        scale,
+        |_, _| 0.0,
+        uniform(rigid_patch(friction)),
+        Vec::new(),
+    )
 }
 
 /// A rigid plane rising at `slope_x` radians toward +x and `slope_y` toward +y.
 pub fn plane_world(scale: f64, slope_x: f64, slope_y: f64, friction: f64) -> World {
     let (tx, ty) = (slope_x.tan(), slope_y.tan());
-    world_from_fn("plane", scale, move |x, y| tx * x + ty * y, uniform(rigid_patch(friction)), Vec::new())
+    world_from_fn(
+        "plane",
+        scale,
+        move |x, y| tx * x + ty * y,
+        uniform(rigid_patch(friction)),
+        Vec::new(),
+    )
 }
 
 /// A plane of soil rising at `slope_x` radians toward +x.
 pub fn soil_world(scale: f64, soil: SoilParams, slope_x: f64) -> World {
     let t = slope_x.tan();
-    world_from_fn("soil", scale, move |x, _| t * x, uniform(soil_patch(soil)), Vec::new())
+    world_from_fn(
+        "soil",
+        scale,
+        move |x, _| t * x,
+        uniform(soil_patch(soil)),
+        Vec::new(),
+    )
 }
 
 /// Rolling bumps: sum of two sines of the given amplitude and wavelength (at full scale).
@@ -106,7 +136,9 @@ pub fn bumpy_world(scale: f64, amplitude: f64, wavelength: f64, friction: f64) -
     world_from_fn(
         "bumpy",
         scale,
-        move |x, y| a * (0.5 * (k * x).sin() + 0.5 * (0.73 * k * y + 0.4).sin() * (0.61 * k * x).cos()),
+        move |x, y| {
+            a * (0.5 * (k * x).sin() + 0.5 * (0.73 * k * y + 0.4).sin() * (0.61 * k * x).cos())
+        },
         uniform(rigid_patch(friction)),
         Vec::new(),
     )
@@ -115,9 +147,20 @@ pub fn bumpy_world(scale: f64, amplitude: f64, wavelength: f64, friction: f64) -
 /// Flat ground with one box rock of full size `size` (world units, already scaled) whose
 /// near face is at x = `front_x`, centred on y = 0, sitting on the ground.
 pub fn rock_world(scale: f64, friction: f64, front_x: f64, size: Vec3) -> World {
-    let rock = Obstacle::rock(box_faces(size), 1.0, Vec3::new(front_x + 0.5 * size.x, 0.0, 0.5 * size.z), 0.0)
-        .expect("a box is a valid rock");
-    world_from_fn("rock", scale, |_, _| 0.0, uniform(rigid_patch(friction)), vec![rock])
+    let rock = Obstacle::rock(
+        box_faces(size),
+        1.0,
+        Vec3::new(front_x + 0.5 * size.x, 0.0, 0.5 * size.z),
+        0.0,
+    )
+    .expect("a box is a valid rock");
+    world_from_fn(
+        "rock",
+        scale,
+        |_, _| 0.0,
+        uniform(rigid_patch(friction)),
+        vec![rock],
+    )
 }
 
 /// Terrain kinds for [`rough_world`].
@@ -137,13 +180,22 @@ pub fn rough_world(scale: f64, seed: u64, relief: f64, surface: RoughSurface) ->
         .map(|k| {
             let wl = 20.0 + 60.0 * rng.uniform() / (1.0 + k as f64 * 0.3);
             let dir = rng.range(0.0, std::f64::consts::TAU);
-            (std::f64::consts::TAU / (wl * scale), dir, rng.range(0.0, std::f64::consts::TAU), rng.range(0.3, 1.0))
+            (
+                std::f64::consts::TAU / (wl * scale),
+                dir,
+                rng.range(0.0, std::f64::consts::TAU),
+                rng.range(0.3, 1.0),
+            )
         })
         .collect();
     let total: f64 = waves.iter().map(|w| w.3).sum();
     let amp = 0.5 * relief * scale / total;
     let height = move |x: f64, y: f64| {
-        waves.iter().map(|&(k, dir, ph, a)| a * (k * (x * dir.cos() + y * dir.sin()) + ph).sin()).sum::<f64>() * amp
+        waves
+            .iter()
+            .map(|&(k, dir, ph, a)| a * (k * (x * dir.cos() + y * dir.sin()) + ph).sin())
+            .sum::<f64>()
+            * amp
             + 0.5 * relief * scale
     };
     let mut patches = Vec::with_capacity(256);
@@ -180,12 +232,20 @@ pub fn rough_world(scale: f64, seed: u64, relief: f64, surface: RoughSurface) ->
         let z = height(x, y);
         if obstacles.len() < 40 {
             let s = rng.range(0.7, 1.2) * scale;
-            let size = Vec3::new(4.4 * s * rng.range(0.4, 1.0), 4.4 * s * rng.range(0.4, 1.0), 3.8 * s * rng.range(0.3, 0.8));
+            let size = Vec3::new(
+                4.4 * s * rng.range(0.4, 1.0),
+                4.4 * s * rng.range(0.4, 1.0),
+                3.8 * s * rng.range(0.3, 0.8),
+            );
             let yaw = rng.range(0.0, std::f64::consts::PI);
-            if let Ok(o) = Obstacle::rock(box_faces(size), s, Vec3::new(x, y, z + 0.3 * size.z), yaw) {
+            if let Ok(o) =
+                Obstacle::rock(box_faces(size), s, Vec3::new(x, y, z + 0.3 * size.z), yaw)
+            {
                 obstacles.push(o);
             }
-        } else if let Ok(o) = Obstacle::tree(0.3 * scale, 5.0 * scale, Vec3::new(x, y, z + 2.5 * scale)) {
+        } else if let Ok(o) =
+            Obstacle::tree(0.3 * scale, 5.0 * scale, Vec3::new(x, y, z + 2.5 * scale))
+        {
             obstacles.push(o);
         }
     }
@@ -206,7 +266,12 @@ pub fn twisting_slope_world(scale: f64, start_deg: f64, deg_per_m: f64, friction
     world_from_fn(
         "twisting-slope",
         scale,
-        move |x, y| y * (start_deg + deg_per_m * x / scale).clamp(0.0, 85.0).to_radians().tan(),
+        move |x, y| {
+            y * (start_deg + deg_per_m * x / scale)
+                .clamp(0.0, 85.0)
+                .to_radians()
+                .tan()
+        },
         uniform(rigid_patch(friction)),
         Vec::new(),
     )

@@ -22,7 +22,10 @@ pub fn builtin_names() -> Vec<&'static str> {
 /// A built-in vehicle by name; unknown names get an error listing the known ones.
 pub fn builtin(name: &str) -> Result<VehicleSpec, SpecError> {
     let Some((_, text)) = BUILTINS.iter().find(|(n, _)| *n == name) else {
-        return Err(SpecError::UnknownVehicle { name: name.to_string(), known: builtin_names().join(", ") });
+        return Err(SpecError::UnknownVehicle {
+            name: name.to_string(),
+            known: builtin_names().join(", "),
+        });
     };
     VehicleSpec::from_yaml_str(text, &format!("built-in vehicle `{name}`"))
 }
@@ -34,5 +37,8 @@ pub fn builtin_yaml(name: &str) -> Option<&'static str> {
 
 /// Every built-in vehicle.
 pub fn all_builtin() -> Vec<VehicleSpec> {
-    builtin_names().into_iter().map(|n| builtin(n).expect("built-in vehicles are valid")).collect()
+    builtin_names()
+        .into_iter()
+        .map(|n| builtin(n).expect("built-in vehicles are valid"))
+        .collect()
 }

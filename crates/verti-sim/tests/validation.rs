@@ -49,10 +49,19 @@ fn static_sag_and_heave_frequency() {
     run(&sim, &mut st, Controls::new(0.0, 1.0, 0.0), 3.0);
     let (front, rear) = corner_loads(&spec);
     for (w, wheel) in st.wheels().iter().enumerate() {
-        let (load, k) = if w < 2 { (front, spec.axles[0].suspension.stiffness) } else { (rear, spec.axles[1].suspension.stiffness) };
+        let (load, k) = if w < 2 {
+            (front, spec.axles[0].suspension.stiffness)
+        } else {
+            (rear, spec.axles[1].suspension.stiffness)
+        };
         let expected = load / k;
         let err = (wheel.compression - expected).abs() / expected;
-        assert!(err < 0.02, "wheel {w}: sag {:.5} m, expected m·g/k = {expected:.5} m ({:.1} %)", wheel.compression, 100.0 * err);
+        assert!(
+            err < 0.02,
+            "wheel {w}: sag {:.5} m, expected m·g/k = {expected:.5} m ({:.1} %)",
+            wheel.compression,
+            100.0 * err
+        );
     }
 
     // Symmetric, undamped variant: both axles like the rear, COM midway, no dampers.
@@ -71,7 +80,8 @@ fn static_sag_and_heave_frequency() {
     st.set_velocity(&sim, Vec3::new(v.x, v.y, 0.05));
     let mut zs = Vec::new();
     for _ in 0..600 {
-        sim.step(&mut st, Controls::new(0.0, 1.0, 0.0), 0.005).unwrap();
+        sim.step(&mut st, Controls::new(0.0, 1.0, 0.0), 0.005)
+            .unwrap();
         zs.push(st.com_position().z);
     }
     let mean = zs.iter().sum::<f64>() / zs.len() as f64;
@@ -83,7 +93,8 @@ fn static_sag_and_heave_frequency() {
         }
     }
     assert!(crossings.len() >= 3, "no heave oscillation: {crossings:?}");
-    let period = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64 * 0.005;
+    let period =
+        (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64 * 0.005;
     let ms = sym.chassis.mass / 4.0;
     let mu = sym.axles[0].wheel.unsprung_mass;
     let (ks, kt) = (sym.axles[0].suspension.stiffness, sym.tyre.radial_stiffness);
@@ -93,14 +104,24 @@ fn static_sag_and_heave_frequency() {
     let w2 = 0.5 * (tr - (tr * tr - 4.0 * det).sqrt());
     let expected = std::f64::consts::TAU / w2.sqrt();
     let err = (period - expected).abs() / expected;
-    assert!(err < 0.05, "heave period {period:.4} s, quarter-car {expected:.4} s ({:.1} %)", 100.0 * err);
+    assert!(
+        err < 0.05,
+        "heave period {period:.4} s, quarter-car {expected:.4} s ({:.1} %)",
+        100.0 * err
+    );
 }
 
 /// Parked (brakes full) facing uphill on a plane of slope `deg` and friction `mu` for 6 s:
 /// returns (distance moved along x over the last 3 s, final speed).
 fn parked(mu: f64, deg: f64) -> (f64, f64) {
     let spec = hmmwv();
-    let (sim, mut st) = sim_at(testing::plane_world(1.0, deg.to_radians(), 0.0, mu), &spec, 0.0, 0.0, 0.0);
+    let (sim, mut st) = sim_at(
+        testing::plane_world(1.0, deg.to_radians(), 0.0, mu),
+        &spec,
+        0.0,
+        0.0,
+        0.0,
+    );
     let brake = Controls::new(0.0, 1.0, 0.0);
     run(&sim, &mut st, brake, 3.0);
     let x0 = st.com_position().x;
@@ -119,9 +140,17 @@ fn parked_on_slope_holds_below_friction_angle_and_slides_above() {
     for mu in [0.4f64, 0.7] {
         let critical = mu.atan().to_degrees();
         let (moved, speed) = parked(mu, critical - 1.5);
-        assert!(moved.abs() < 0.01 && speed < 1e-3, "μ {mu}: at {:.1}° it moved {moved:.4} m, speed {speed:.4} m/s (should hold)", critical - 1.5);
+        assert!(
+            moved.abs() < 0.01 && speed < 1e-3,
+            "μ {mu}: at {:.1}° it moved {moved:.4} m, speed {speed:.4} m/s (should hold)",
+            critical - 1.5
+        );
         let (moved, speed) = parked(mu, critical + 1.5);
-        assert!(moved < 0.0 && speed > 0.3, "μ {mu}: at {:.1}° it moved {moved:.3} m, speed {speed:.3} m/s (should slide down)", critical + 1.5);
+        assert!(
+            moved < 0.0 && speed > 0.3,
+            "μ {mu}: at {:.1}° it moved {moved:.3} m, speed {speed:.3} m/s (should slide down)",
+            critical + 1.5
+        );
     }
 }
 
@@ -139,7 +168,8 @@ fn static_com_height(spec: &VehicleSpec) -> f64 {
     let total = spec.total_mass();
     let com_z = (spec.chassis.mass * spec.chassis.com[2] + 2.0 * mu * (hf + hr)) / total;
     let tyre_load = 0.25 * total * G;
-    let ground = 0.5 * (hf + hr) - (spec.axles[0].wheel.radius - tyre_load / spec.tyre.radial_stiffness);
+    let ground =
+        0.5 * (hf + hr) - (spec.axles[0].wheel.radius - tyre_load / spec.tyre.radial_stiffness);
     com_z - ground
 }
 
@@ -158,7 +188,13 @@ fn grippy(mut spec: VehicleSpec) -> VehicleSpec {
 
 /// Largest |roll| over `seconds` across a side slope of `deg` (left side uphill).
 fn max_roll_on_side_slope(spec: &VehicleSpec, deg: f64, seconds: f64, controls: Controls) -> f64 {
-    let (sim, mut st) = sim_at(testing::plane_world(spec.scale, 0.0, deg.to_radians(), 2.0), spec, 0.0, 0.0, 0.0);
+    let (sim, mut st) = sim_at(
+        testing::plane_world(spec.scale, 0.0, deg.to_radians(), 2.0),
+        spec,
+        0.0,
+        0.0,
+        0.0,
+    );
     let mut worst: f64 = 0.0;
     for _ in 0..(seconds / 0.01) as usize {
         sim.step(&mut st, controls, 0.01).unwrap();
@@ -170,40 +206,51 @@ fn max_roll_on_side_slope(spec: &VehicleSpec, deg: f64, seconds: f64, controls: 
     worst
 }
 
-/// A slowly tilting table: the vehicle crawls along a cross slope that steepens by 0.25° per
-/// (scaled) metre, holding its heading, and the slope under its centre of mass when it tips
-/// (roll 25° beyond the local slope) is returned [deg]. At 0.5·√scale m/s the table tilts by
-/// about 0.1° per second, slow enough to be quasi-static.
-fn tip_angle(spec: &VehicleSpec) -> f64 {
-    let s = spec.scale;
-    let (start, rate) = (35.0, 0.25);
-    let (sim, mut st) = sim_at(testing::twisting_slope_world(s, start, rate, 2.0), spec, -40.0 * s, 0.0, 0.0);
-    for _ in 0..40_000 {
-        let u = (0.5 * (0.5 * s.sqrt() - st.forward_speed())).clamp(-1.0, 1.0);
-        let steer = (-3.0 * st.euler().2).clamp(-1.0, 1.0);
-        sim.step(&mut st, Controls::new(u.max(0.0), (-u).max(0.0), steer), 0.01).unwrap();
-        let slope = start + rate * st.com_position().x / s;
-        if st.euler().0.abs().to_degrees() > slope + 25.0 || st.is_rolled_over() {
-            return slope;
-        }
-    }
-    panic!("{} never tipped", spec.name);
-}
-
 // 3. Tilt table: a rigid vehicle tips when the resultant of gravity passes the downhill wheels,
 //    tan φ = t / (2h) with t the track and h the static COM height (derived from the file by
 //    `static_com_height`). HMMWV: h ≈ 0.61 m, φ ≈ 56°; 1/10 crawler: h ≈ 0.08 m, φ ≈ 51°.
-//    The table tilts slowly (`tip_angle`); the slope at which the vehicle tips must match φ
-//    within 5 %. Friction 2 on tyre and ground so it tips before sliding.
+//    Within 5 %: parked across a slope of 0.95·φ it stays upright (the body never rolls more
+//    than 10° beyond the slope: springs and tyres let it lean a few degrees as the uphill
+//    wheels unload, a tipping vehicle goes on to 180°), at 1.05·φ it rolls over. Friction 2 on
+//    tyre and ground so it tips before sliding.
+//    The formula is for a rigid vehicle. The HMMWV's stiff springs lean it about 1° at 40° and
+//    it is tested as shipped; the crawler's soft springs (15 mm sag on a 0.2 m track) lean it
+//    6° at 40°, which moves the COM downhill and tips it near 46° (physically right for a soft
+//    vehicle), so it is tested with springs 10x and tyres 5x stiffer at the same ride height.
 #[test]
 fn tilt_table_rollover_angle() {
     for name in ["hmmwv", "verti4"] {
-        let spec = grippy(vehicles::builtin(name).unwrap());
+        let mut spec = grippy(vehicles::builtin(name).unwrap());
+        if name == "verti4" {
+            let (front, rear) = corner_loads(&spec);
+            for (i, ax) in spec.axles.iter_mut().enumerate() {
+                let load = if i == 0 { front } else { rear };
+                let old_sag = load / ax.suspension.stiffness;
+                ax.suspension.stiffness *= 10.0;
+                ax.suspension.damping *= 10f64.sqrt();
+                ax.suspension.stop_stiffness *= 10.0;
+                ax.z += old_sag - load / ax.suspension.stiffness;
+            }
+            spec.tyre.radial_stiffness *= 5.0;
+            spec.tyre.radial_damping *= 5f64.sqrt();
+        }
         let h = static_com_height(&spec);
         let phi = (spec.axles[0].track / (2.0 * h)).atan().to_degrees();
-        let tipped = tip_angle(&spec);
-        let err = (tipped - phi).abs() / phi;
-        assert!(err < 0.05, "{name}: tipped at {tipped:.1}°, tan φ = t/2h gives {phi:.1}° ({:.1} %)", 100.0 * err);
+        let brake = Controls::new(0.0, 1.0, 0.0);
+        let below = max_roll_on_side_slope(&spec, 0.95 * phi, 4.0, brake);
+        let above = max_roll_on_side_slope(&spec, 1.05 * phi, 4.0, brake);
+        assert!(
+            below.to_degrees() < 0.95 * phi + 10.0,
+            "{name}: at {:.1}° (0.95 φ, φ = {phi:.1}°) roll reached {:.1}°",
+            0.95 * phi,
+            below.to_degrees()
+        );
+        assert!(
+            above.to_degrees() > 90.0,
+            "{name}: at {:.1}° (1.05 φ) it did not roll over (max roll {:.1}°)",
+            1.05 * phi,
+            above.to_degrees()
+        );
     }
 }
 
@@ -220,7 +267,8 @@ fn braking_distance_matches_friction() {
     st.set_velocity(&sim, Vec3::new(v0, 0.0, 0.0));
     let x0 = st.com_position().x;
     for _ in 0..1000 {
-        sim.step(&mut st, Controls::new(0.0, 1.0, 0.0), 0.01).unwrap();
+        sim.step(&mut st, Controls::new(0.0, 1.0, 0.0), 0.01)
+            .unwrap();
         if st.velocity_world().norm() < 0.01 {
             break;
         }
@@ -228,7 +276,11 @@ fn braking_distance_matches_friction() {
     let distance = st.com_position().x - x0;
     let expected = v0 * v0 / (2.0 * mu * G);
     let err = (distance - expected).abs() / expected;
-    assert!(err < 0.10, "stopped in {distance:.2} m, v²/(2μg) = {expected:.2} m ({:.1} %)", 100.0 * err);
+    assert!(
+        err < 0.10,
+        "stopped in {distance:.2} m, v²/(2μg) = {expected:.2} m ({:.1} %)",
+        100.0 * err
+    );
 }
 
 /// Bekker's closed form for a rigid wheel of width b and radius R at rest under load W, with
@@ -256,7 +308,10 @@ fn rigid_wheel_sinkage_matches_bekker() {
     // dropped onto plastic soil overshoots and the plastic memory keeps the deepest point.
     // Heavy soil damping (which vanishes at rest and is absent from the closed form) makes
     // the settling slow and monotonic.
-    let soil = SoilParams { damping: 3e6, ..SoilParams::MID };
+    let soil = SoilParams {
+        damping: 3e6,
+        ..SoilParams::MID
+    };
     let (sim, mut st) = sim_at(testing::soil_world(1.0, soil, 0.0), &spec, 0.0, 0.0, 0.0);
     run(&sim, &mut st, Controls::new(0.0, 1.0, 0.0), 6.0);
     let (front, rear) = corner_loads(&spec);
@@ -267,7 +322,11 @@ fn rigid_wheel_sinkage_matches_bekker() {
         let expected = bekker_static_sinkage(load, 0.3, spec.axles[0].wheel.radius, &soil);
         let sinkage = spec.axles[0].wheel.radius - hub.z; // flat soil at z = 0
         let err = (sinkage - expected).abs() / expected;
-        assert!(err < 0.10, "wheel {w}: sinkage {sinkage:.4} m, Bekker {expected:.4} m ({:.1} %)", 100.0 * err);
+        assert!(
+            err < 0.10,
+            "wheel {w}: sinkage {sinkage:.4} m, Bekker {expected:.4} m ({:.1} %)",
+            100.0 * err
+        );
     }
 }
 
@@ -289,15 +348,22 @@ fn stuck_in_snow_on_a_slope_it_climbs_on_concrete() {
     let slope = 32f64.to_radians();
     let concrete = climb(testing::plane_world(1.0, slope, 0.0, 0.85));
     let snow = climb(testing::soil_world(1.0, SoilParams::SOFT, slope));
-    assert!(concrete > 20.0, "on concrete it only climbed {concrete:.2} m");
+    assert!(
+        concrete > 20.0,
+        "on concrete it only climbed {concrete:.2} m"
+    );
     assert!(snow < 2.0, "on snow it climbed {snow:.2} m");
 }
 
 /// Least-squares (Kåsa) circle through points: returns the radius.
 fn fit_circle(points: &[(f64, f64)]) -> f64 {
     let n = points.len() as f64;
-    let (mx, my) = (points.iter().map(|p| p.0).sum::<f64>() / n, points.iter().map(|p| p.1).sum::<f64>() / n);
-    let (mut suu, mut svv, mut suv, mut suuu, mut svvv, mut suvv, mut svuu) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mx, my) = (
+        points.iter().map(|p| p.0).sum::<f64>() / n,
+        points.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let (mut suu, mut svv, mut suv, mut suuu, mut svvv, mut suvv, mut svuu) =
+        (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     for &(x, y) in points {
         let (u, v) = (x - mx, y - my);
         suu += u * u;
@@ -333,7 +399,8 @@ fn low_speed_cornering_follows_ackermann() {
         // gentle throttle-only speed hold (≈ 1 m/s): a bang-bang throttle/brake controller
         // would spin and lock the wheels and measure the controller, not the steering
         let u = (0.1 * (1.5 - st.forward_speed())).clamp(0.0, 1.0);
-        sim.step(&mut st, Controls::new(u, 0.0, steer), 0.01).unwrap();
+        sim.step(&mut st, Controls::new(u, 0.0, steer), 0.01)
+            .unwrap();
         if k >= 1500 && k % 10 == 0 {
             let rear = sim.point_world(&st, Vec3::new(spec.axles[1].x, 0.0, 0.0));
             points.push((rear.x, rear.y));
@@ -343,7 +410,11 @@ fn low_speed_cornering_follows_ackermann() {
     let delta = steer * spec.steering.max_angle_deg.to_radians();
     let expected = (spec.axles[0].x - spec.axles[1].x) / delta.tan();
     let err = (radius - expected).abs() / expected;
-    assert!(err < 0.05, "turn radius {radius:.2} m, Ackermann {expected:.2} m ({:.1} %)", 100.0 * err);
+    assert!(
+        err < 0.05,
+        "turn radius {radius:.2} m, Ackermann {expected:.2} m ({:.1} %)",
+        100.0 * err
+    );
 }
 
 // 7. No energy gain: with no input on bumpy terrain (a rest state that is not an equilibrium),
@@ -353,7 +424,13 @@ fn low_speed_cornering_follows_ackermann() {
 #[test]
 fn no_energy_gain_on_bumpy_terrain() {
     let spec = hmmwv();
-    let (sim, mut st) = sim_at(testing::bumpy_world(1.0, 0.6, 10.0, 0.8), &spec, 1.3, 0.7, 0.4);
+    let (sim, mut st) = sim_at(
+        testing::bumpy_world(1.0, 0.6, 10.0, 0.8),
+        &spec,
+        1.3,
+        0.7,
+        0.4,
+    );
     sim.step(&mut st, Controls::IDLE, 0.01).unwrap();
     let e0 = sim.energy(&st);
     let tolerance = sim.total_mass() / 1000.0;
@@ -362,9 +439,17 @@ fn no_energy_gain_on_bumpy_terrain() {
         sim.step(&mut st, Controls::IDLE, 0.01).unwrap();
         let e = sim.energy(&st);
         worst = worst.max(e - e0);
-        assert!(e <= e0 + tolerance, "energy rose by {:.3} J at t = {:.2} s", e - e0, st.time());
+        assert!(
+            e <= e0 + tolerance,
+            "energy rose by {:.3} J at t = {:.2} s",
+            e - e0,
+            st.time()
+        );
     }
-    assert!(sim.energy(&st) < e0, "energy did not decrease (worst rise {worst:.3} J)");
+    assert!(
+        sim.energy(&st) < e0,
+        "energy did not decrease (worst rise {worst:.3} J)"
+    );
 }
 
 // 8a. Driving at 10 m/s into a 2.5 m tall rock stops the vehicle: it never gets more than
@@ -374,16 +459,30 @@ fn no_energy_gain_on_bumpy_terrain() {
 fn rock_stops_the_vehicle() {
     let spec = hmmwv();
     let face = 12.0;
-    let (sim, mut st) = sim_at(testing::rock_world(1.0, 0.8, face, Vec3::new(3.0, 4.0, 2.5)), &spec, 0.0, 0.0, 0.0);
+    let (sim, mut st) = sim_at(
+        testing::rock_world(1.0, 0.8, face, Vec3::new(3.0, 4.0, 2.5)),
+        &spec,
+        0.0,
+        0.0,
+        0.0,
+    );
     st.set_velocity(&sim, Vec3::new(10.0, 0.0, 0.0));
     let mut furthest: f64 = f64::NEG_INFINITY;
     for _ in 0..400 {
-        sim.step(&mut st, Controls::new(1.0, 0.0, 0.0), 0.01).unwrap();
+        sim.step(&mut st, Controls::new(1.0, 0.0, 0.0), 0.01)
+            .unwrap();
         let front = sim.point_world(&st, Vec3::new(2.3, 0.0, 0.5));
         furthest = furthest.max(front.x);
     }
-    assert!(furthest < face + 0.5, "the front reached x = {furthest:.2} m, the rock face is at {face} m");
-    assert!(st.velocity_world().norm() < 1.0, "still moving at {:.2} m/s", st.velocity_world().norm());
+    assert!(
+        furthest < face + 0.5,
+        "the front reached x = {furthest:.2} m, the rock face is at {face} m"
+    );
+    assert!(
+        st.velocity_world().norm() < 1.0,
+        "still moving at {:.2} m/s",
+        st.velocity_world().norm()
+    );
     assert!(st.contacts().chassis_obstacle_points + st.contacts().wheel_obstacle_contacts > 0);
 }
 
@@ -399,8 +498,18 @@ fn side_slope_rollover_while_driving() {
     let drive = Controls::new(0.3, 0.0, 0.0);
     let below = max_roll_on_side_slope(&spec, 0.8 * phi, 6.0, drive);
     let above = max_roll_on_side_slope(&spec, 1.1 * phi, 6.0, drive);
-    assert!(below.to_degrees() < phi, "at 0.8 φ = {:.1}° roll reached {:.1}°", 0.8 * phi, below.to_degrees());
-    assert!(above.to_degrees() > 90.0, "at 1.1 φ = {:.1}° no rollover (max roll {:.1}°)", 1.1 * phi, above.to_degrees());
+    assert!(
+        below.to_degrees() < 0.8 * phi + 10.0,
+        "at 0.8 φ = {:.1}° roll reached {:.1}°",
+        0.8 * phi,
+        below.to_degrees()
+    );
+    assert!(
+        above.to_degrees() > 90.0,
+        "at 1.1 φ = {:.1}° no rollover (max roll {:.1}°)",
+        1.1 * phi,
+        above.to_degrees()
+    );
 }
 
 fn random_drive(sim: &Sim, st: &mut SimState, seed: u64, steps: usize) -> Vec<u64> {
@@ -409,7 +518,15 @@ fn random_drive(sim: &Sim, st: &mut SimState, seed: u64, steps: usize) -> Vec<u6
     let mut c = Controls::IDLE;
     for k in 0..steps {
         if k % 25 == 0 {
-            c = Controls::new(rng.uniform(), if rng.uniform() < 0.2 { rng.uniform() } else { 0.0 }, rng.range(-1.0, 1.0));
+            c = Controls::new(
+                rng.uniform(),
+                if rng.uniform() < 0.2 {
+                    rng.uniform()
+                } else {
+                    0.0
+                },
+                rng.range(-1.0, 1.0),
+            );
         }
         sim.step(st, c, 0.02).unwrap();
         let p = st.com_position();
@@ -426,18 +543,30 @@ fn random_drive(sim: &Sim, st: &mut SimState, seed: u64, steps: usize) -> Vec<u6
 fn bit_identical_trajectories_and_clones() {
     let world = Arc::new(testing::rough_world(1.0, 7, 8.0, RoughSurface::Mixed));
     let spec = hmmwv();
-    let sim = Sim::new(&world, &spec, start_pose(&world, &spec, 0.0, 0.0, 0.5).unwrap()).unwrap();
+    let sim = Sim::new(
+        &world,
+        &spec,
+        start_pose(&world, &spec, 0.0, 0.0, 0.5).unwrap(),
+    )
+    .unwrap();
     let mut a = sim.initial_state();
     let mut b = sim.initial_state();
     let ta = random_drive(&sim, &mut a, 11, 500);
     let tb = random_drive(&sim, &mut b, 11, 500);
     assert_eq!(ta, tb);
-    assert!(a.soil().deformed_nodes() > 0, "the drive should have crossed soil");
+    assert!(
+        a.soil().deformed_nodes() > 0,
+        "the drive should have crossed soil"
+    );
     let mut c = a.clone();
     assert!(c.soil().shares_storage_with(a.soil()));
     let tc = random_drive(&sim, &mut c, 12, 200);
     let before = a.clone();
     let ta2 = random_drive(&sim, &mut a, 12, 200);
     assert_eq!(ta2, tc);
-    assert_ne!(before.soil(), a.soil(), "the original's soil changes only through its own steps");
+    assert_ne!(
+        before.soil(),
+        a.soil(),
+        "the original's soil changes only through its own steps"
+    );
 }
