@@ -24,7 +24,7 @@ use crate::error::SimError;
 use crate::powertrain::{RPM_TO_RAD_S, engine_torque, shift};
 use crate::soil::{SoilLayout, SoilState, bekker_pressure, bekker_slope};
 use crate::spec::{Differential, SteeringKind, VehicleSpec};
-use crate::terrain::{Ground, HeightBound, ObstacleGrid};
+use crate::terrain::{FastObstacle, Ground, HeightBound, ObstacleGrid};
 use crate::tyre::{janosi_fraction, janosi_sliding_slip, tmeasy_combined, tmeasy_sliding_slip};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -437,6 +437,7 @@ pub struct Sim {
     bound: HeightBound,
     ground: Ground,
     obstacles: ObstacleGrid,
+    fast_obstacles: Vec<FastObstacle>,
     soil: Option<SoilLayout>,
     driven_wheels: usize,
 }
@@ -738,6 +739,7 @@ impl Sim {
         let sim = Sim {
             bound: HeightBound::new(world),
             ground: Ground::new(world),
+            fast_obstacles: world.obstacles.iter().map(FastObstacle::new).collect(),
             obstacles: ObstacleGrid::new(world, reach),
             world: Arc::clone(world),
             spec: spec.clone(),
@@ -1406,7 +1408,6 @@ impl Sim {
 
     /// Contact of one wheel with rigid terrain, obstacles and soil.
     #[allow(clippy::too_many_arguments)]
-    #[inline(never)]
     fn wheel_contact(
         &self,
         st: &mut SimState,
@@ -1542,7 +1543,8 @@ impl Sim {
             if hub.z - r > z1 || hub.z + r < z0 {
                 continue;
             }
-            let (d_hub, n_hub) = o.signed_distance(hub);
+            let fo = &self.fast_obstacles[k as usize];
+            let (d_hub, n_hub) = fo.signed_distance(hub);
             if d_hub > r + m.half_width {
                 continue;
             }
@@ -1553,7 +1555,7 @@ impl Sim {
             } else {
                 hub - n_hub * m.half_width
             };
-            let (d, n) = o.signed_distance(support);
+            let (d, n) = fo.signed_distance(support);
             if d < 0.0 && obstacle_best.is_none_or(|(bd, _)| -d > bd) {
                 obstacle_best = Some((-d, n));
             }
@@ -1572,7 +1574,6 @@ impl Sim {
     /// SCM under one wheel: visits the nodes under the lower part of the wheel, updates their
     /// plastic memory and sums the pressure forces and their moment about the hub.
     #[allow(clippy::too_many_arguments)]
-    #[inline(never)]
     fn soil_contact(
         &self,
         st: &mut SimState,
@@ -1726,7 +1727,6 @@ impl Sim {
 
     /// Chassis collision box against terrain (rigid, or the undeformed soil surface) and
     /// obstacles: compliant normal force plus regularised Coulomb friction.
-    #[inline(never)]
     fn body_contacts(
         &self,
         st: &SimState,
@@ -1809,13 +1809,14 @@ impl Sim {
             }
             // The face-plane distance of the box centre bounds every box point's distance
             // from below, so one query rules out most nearby obstacles.
+            let fo = &self.fast_obstacles[k as usize];
             let box_world = st.position + q.rotate(self.box_center);
-            if o.signed_distance(box_world).0 > self.box_half.norm() {
+            if fo.signed_distance(box_world).0 > self.box_half.norm() {
                 continue;
             }
             // chassis points inside the obstacle
             for p in &pts {
-                let (d, n) = o.signed_distance(*p);
+                let (d, n) = fo.signed_distance(*p);
                 if d < 0.0 && apply(*p, n, -d, mu_obs) {
                     contacts.chassis_obstacle_points += 1;
                 }

@@ -255,3 +255,105 @@ mod tests {
         assert!((h - w.terrain.height_at(64.0, 3.0)).abs() < 1e-9 && gx == 0.0);
     }
 }
+
+/// An obstacle in the form the contact loops want: world-frame face planes for rocks (no
+/// rotation per query), the vertical axis for trees.
+#[derive(Clone, Debug)]
+pub struct FastObstacle {
+    /// Rock faces as (outward unit normal, offset) in the world frame: inside when every
+    /// `n·p − d < 0`. Empty for trees.
+    pub faces: Vec<(verti_core::Vec3, f64)>,
+    /// Tree: (centre x, centre y, radius, z min, z max).
+    pub tree: Option<(f64, f64, f64, f64, f64)>,
+}
+
+impl FastObstacle {
+    pub fn new(o: &verti_world::Obstacle) -> FastObstacle {
+        match o.shape() {
+            verti_world::ObstacleShape::Rock { faces, .. } => {
+                let rot = verti_core::Quat::from_axis_angle(verti_core::Vec3::Z, o.yaw());
+                let p = o.position();
+                let faces = faces
+                    .iter()
+                    .map(|f| {
+                        let n = rot.rotate(f.normal);
+                        (n, f.offset + n.dot(p))
+                    })
+                    .collect();
+                FastObstacle { faces, tree: None }
+            }
+            verti_world::ObstacleShape::Tree { radius, height } => {
+                let p = o.position();
+                FastObstacle {
+                    faces: Vec::new(),
+                    tree: Some((p.x, p.y, *radius, p.z - 0.5 * height, p.z + 0.5 * height)),
+                }
+            }
+        }
+    }
+
+    /// Same contract as `Obstacle::signed_distance`: signed distance (negative inside, exact
+    /// inside, a lower bound outside a rock) and the outward normal of the nearest surface.
+    #[inline]
+    pub fn signed_distance(&self, p: verti_core::Vec3) -> (f64, verti_core::Vec3) {
+        use verti_core::Vec3;
+        if let Some((cx, cy, radius, z0, z1)) = self.tree {
+            let (dx, dy) = (p.x - cx, p.y - cy);
+            let r = (dx * dx + dy * dy).sqrt();
+            let dr = r - radius;
+            let half = 0.5 * (z1 - z0);
+            let zc = 0.5 * (z0 + z1);
+            let dz = (p.z - zc).abs() - half;
+            let radial = if r > 1e-12 {
+                Vec3::new(dx / r, dy / r, 0.0)
+            } else {
+                Vec3::X
+            };
+            let vertical = Vec3::new(0.0, 0.0, (p.z - zc).signum());
+            return if dr > 0.0 && dz > 0.0 {
+                let d = (dr * dr + dz * dz).sqrt();
+                (d, (radial * dr + vertical * dz) / d)
+            } else if dr > dz {
+                (dr, radial)
+            } else {
+                (dz, vertical)
+            };
+        }
+        let mut best = f64::NEG_INFINITY;
+        let mut normal = Vec3::Z;
+        for &(n, d) in &self.faces {
+            let s = n.dot(p) - d;
+            if s > best {
+                best = s;
+                normal = n;
+            }
+        }
+        (best, normal)
+    }
+}
+
+#[cfg(test)]
+mod fast_obstacle_tests {
+    use super::*;
+    use verti_core::{Rng, Vec3};
+
+    #[test]
+    fn matches_world_obstacles() {
+        let w = crate::testing::rough_world(1.0, 4, 8.0, crate::testing::RoughSurface::Rigid);
+        let mut rng = Rng::new(9);
+        for o in &w.obstacles {
+            let f = FastObstacle::new(o);
+            for _ in 0..50 {
+                let p = o.position()
+                    + Vec3::new(
+                        rng.range(-4.0, 4.0),
+                        rng.range(-4.0, 4.0),
+                        rng.range(-3.0, 3.0),
+                    );
+                let (a, na) = f.signed_distance(p);
+                let (b, nb) = o.signed_distance(p);
+                assert!((a - b).abs() < 1e-9 && (na - nb).norm() < 1e-9, "{a} {b}");
+            }
+        }
+    }
+}

@@ -1,0 +1,221 @@
+//! The engine's contract: vehicle files, errors instead of panics, every shipped vehicle
+//! driving every kind of test world, cheap clones.
+
+use std::sync::Arc;
+use verti_core::Vec3;
+use verti_sim::testing::{self, RoughSurface};
+use verti_sim::{Controls, Sim, SimError, SpecError, VehicleSpec, start_pose, vehicles};
+use verti_world::SoilParams;
+
+#[test]
+fn builtin_vehicles_load_and_unknown_names_list_the_known_ones() {
+    let names = vehicles::builtin_names();
+    assert_eq!(
+        names,
+        ["hmmwv", "artcar", "verti4", "truck6", "truck8", "m113"]
+    );
+    for name in &names {
+        let spec = vehicles::builtin(name).unwrap();
+        assert_eq!(&spec.name, name);
+        assert!(!spec.summary().is_empty());
+        // YAML round trip
+        let again = VehicleSpec::from_yaml_str(&spec.to_yaml(), "round trip").unwrap();
+        assert_eq!(again, spec);
+    }
+    assert_eq!(vehicles::builtin("m113").unwrap().wheel_count(), 10);
+    assert!(vehicles::builtin("m113").unwrap().is_tracked());
+    let err = vehicles::builtin("tank").unwrap_err().to_string();
+    assert!(
+        err.contains("tank") && err.contains("hmmwv") && err.contains("m113"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_vehicle_files_name_the_file_and_the_field() {
+    let dir = std::env::temp_dir().join(format!("verti-sim-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.yaml");
+    let text = vehicles::builtin_yaml("hmmwv")
+        .unwrap()
+        .replace("stiffness: 167071.0", "stiffness: -5.0");
+    std::fs::write(&path, text).unwrap();
+    let err = VehicleSpec::from_file(&path).unwrap_err();
+    let msg = err.to_string();
+    assert!(matches!(err, SpecError::Invalid { .. }), "{msg}");
+    assert!(
+        msg.contains("bad.yaml") && msg.contains("axles[0].suspension.stiffness"),
+        "{msg}"
+    );
+
+    let text = vehicles::builtin_yaml("hmmwv")
+        .unwrap()
+        .replace("friction: 0.9", "friction: 0.9\n  colour: red");
+    std::fs::write(&path, text).unwrap();
+    let msg = VehicleSpec::from_file(&path).unwrap_err().to_string();
+    assert!(msg.contains("bad.yaml") && msg.contains("colour"), "{msg}");
+
+    let msg = VehicleSpec::from_file(dir.join("missing.yaml"))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("missing.yaml"), "{msg}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bad_inputs_are_errors_not_panics() {
+    let world = Arc::new(testing::flat_world(1.0, 0.8));
+    let spec = vehicles::builtin("hmmwv").unwrap();
+    assert!(matches!(
+        start_pose(&world, &spec, 500.0, 0.0, 0.0),
+        Err(SimError::InvalidStart(_))
+    ));
+    assert!(matches!(
+        start_pose(&world, &spec, f64::NAN, 0.0, 0.0),
+        Err(SimError::InvalidStart(_))
+    ));
+    let sim = Sim::new(
+        &world,
+        &spec,
+        start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
+    )
+    .unwrap();
+    let mut st = sim.initial_state();
+    for (c, name) in [
+        (Controls::new(f64::NAN, 0.0, 0.0), "throttle"),
+        (Controls::new(0.0, 1.5, 0.0), "brake"),
+        (Controls::new(0.0, 0.0, -1.01), "steering"),
+        (Controls::new(0.0, 0.0, f64::INFINITY), "steering"),
+    ] {
+        let e = sim.step(&mut st, c, 0.01).unwrap_err();
+        assert!(
+            matches!(e, SimError::InvalidControl { .. }) && e.to_string().contains(name),
+            "{e}"
+        );
+    }
+    for dt in [0.0, -1.0, f64::NAN, 100.0] {
+        assert!(matches!(
+            sim.step(&mut st, Controls::IDLE, dt),
+            Err(SimError::InvalidStep(_))
+        ));
+    }
+    // a non-finite state is reported by name, and stays an error
+    st.set_velocity(&sim, Vec3::new(f64::NAN, 0.0, 0.0));
+    let e = sim.step(&mut st, Controls::IDLE, 0.01).unwrap_err();
+    assert!(
+        matches!(e, SimError::NonFinite { .. }) && e.to_string().contains("velocity"),
+        "{e}"
+    );
+    // a fresh state is unaffected
+    let mut fresh = sim.initial_state();
+    sim.step(&mut fresh, Controls::IDLE, 0.01).unwrap();
+}
+
+#[test]
+fn every_vehicle_drives_every_kind_of_world() {
+    for spec in vehicles::all_builtin() {
+        let s = spec.scale;
+        let worlds = [
+            testing::flat_world(s, 0.8),
+            testing::bumpy_world(s, 0.4, 8.0, 0.7),
+            testing::soil_world(s, SoilParams::MID, 0.0),
+            testing::rough_world(s, 3, 8.0, RoughSurface::Mixed),
+        ];
+        for world in worlds {
+            let name = world.meta.name.clone();
+            let world = Arc::new(world);
+            let sim = Sim::new(
+                &world,
+                &spec,
+                start_pose(&world, &spec, 0.0, 0.0, 0.2).unwrap(),
+            )
+            .unwrap();
+            let mut st = sim.initial_state();
+            let start = sim.reference_pose(&st).position;
+            for k in 0..300 {
+                let c = Controls::new(0.5, 0.0, if k > 150 { 0.3 } else { 0.0 });
+                sim.step(&mut st, c, 0.02)
+                    .unwrap_or_else(|e| panic!("{} on {name}: {e}", spec.name));
+            }
+            let moved = (sim.reference_pose(&st).position - start).norm_xy();
+            if name == "test/flat" {
+                assert!(!st.is_rolled_over(), "{} rolled over on {name}", spec.name);
+                // at least a metre per second of scale-adjusted speed on average over 6 s
+                assert!(
+                    moved > 3.0 * s.sqrt(),
+                    "{} moved only {moved:.2} m on {name}",
+                    spec.name
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn state_accessors_are_consistent() {
+    let world = Arc::new(testing::flat_world(1.0, 0.8));
+    let spec = vehicles::builtin("hmmwv").unwrap();
+    let sim = Sim::new(
+        &world,
+        &spec,
+        start_pose(&world, &spec, 2.0, -3.0, 1.0).unwrap(),
+    )
+    .unwrap();
+    let mut st = sim.initial_state();
+    for _ in 0..100 {
+        sim.step(&mut st, Controls::new(0.5, 0.0, 0.0), 0.02)
+            .unwrap();
+    }
+    assert!((st.time() - 2.0).abs() < 1e-9);
+    let (_, _, yaw) = st.euler();
+    assert!((yaw - 1.0).abs() < 0.05, "yaw {yaw}");
+    let v = st.velocity_world();
+    let vb = st.velocity_body();
+    assert!((v.norm() - vb.norm()).abs() < 1e-9 && (st.forward_speed() - vb.x).abs() < 1e-12);
+    assert!(st.forward_speed() > 1.0);
+    assert_eq!(st.wheels().len(), 4);
+    assert_eq!(st.contacts().wheels_in_contact, 4);
+    assert!(
+        st.wheels()
+            .iter()
+            .all(|w| w.normal_force > 0.0 && w.spin_rate > 0.0)
+    );
+    let centers = sim.wheel_centers(&st);
+    let pose = sim.reference_pose(&st);
+    // wheel centres sit about one radius above the flat ground
+    for c in &centers {
+        assert!((c.z - 0.45).abs() < 0.03, "{c:?}");
+    }
+    assert!((pose.position - st.com_position()).norm() < 0.3);
+}
+
+#[test]
+fn soil_is_copy_on_write_and_ruts_persist() {
+    let world = Arc::new(testing::soil_world(1.0, SoilParams::SOFT, 0.0));
+    let spec = vehicles::builtin("hmmwv").unwrap();
+    let sim = Sim::new(
+        &world,
+        &spec,
+        start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
+    )
+    .unwrap();
+    let mut st = sim.initial_state();
+    for _ in 0..100 {
+        sim.step(&mut st, Controls::new(0.6, 0.0, 0.0), 0.02)
+            .unwrap();
+    }
+    assert!(st.contacts().wheels_on_soil == 4 && st.soil().deformed_nodes() > 50);
+    // the start spot is now a rut (the wheels sat there) and stays one
+    let front_start = sim.point_world(&sim.initial_state(), Vec3::new(spec.axles[0].x, 0.0, 0.0));
+    let side = 0.5 * spec.axles[0].track;
+    let rut = sim.ground_height_at(&st, front_start.x, front_start.y + side);
+    assert!(rut < -0.05, "rut depth {rut:.3} m");
+    // a clone shares the soil until one of them steps
+    let mut other = st.clone();
+    assert!(other.soil().shares_storage_with(st.soil()));
+    let before = st.clone();
+    sim.step(&mut other, Controls::new(0.6, 0.0, 0.0), 0.02)
+        .unwrap();
+    assert!(!other.soil().shares_storage_with(st.soil()));
+    assert_eq!(st, before, "stepping a clone must not touch the original");
+}
