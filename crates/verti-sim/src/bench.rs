@@ -310,7 +310,7 @@ pub fn soak(
         let (x, y, yaw) = (
             rng.range(-half, half),
             rng.range(-half, half),
-            rng.range(-3.14, 3.14),
+            rng.range(-std::f64::consts::PI, std::f64::consts::PI),
         );
         let record = |report: &mut SoakReport, e: SimError, time: f64| {
             report.failures.push(SoakFailure {

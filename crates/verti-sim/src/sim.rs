@@ -373,6 +373,8 @@ struct LongTyre {
     /// κ_new = a + b·ω_new.
     a: f64,
     b: f64,
+    /// 1 + h·v_ref/σ: the implicit relaxation factor of this step.
+    decay: f64,
     /// Low-speed bristle damping [N s/m].
     damping: f64,
     vx: f64,
@@ -1199,6 +1201,7 @@ impl Sim {
                     stiffness: secant,
                     a: (kx - h * vx / spec.tyre.relaxation_length) / decay,
                     b: h * radius / (spec.tyre.relaxation_length * decay),
+                    decay,
                     damping: fade * m.slip_damping_long,
                     vx,
                     radius,
@@ -1359,23 +1362,25 @@ impl Sim {
         }
 
         // ---- transient slip (implicit relaxation, after the spin update) ----
+        // Longitudinally the state takes exactly the value the spin solve used (κ = a + b·ω);
+        // laterally it relaxes with the same decay.
         let sigma = spec.tyre.relaxation_length;
-        for w in 0..nw {
-            let m = &self.wheels[w];
-            let (vx, vy, radius, clamp, fz) = slip_inputs[w];
-            let ws = &mut st.wheels[w];
-            if fz <= 0.0 {
+        for ((ws, &(_vx, vy, _radius, clamp, fz)), lt) in st
+            .wheels
+            .iter_mut()
+            .zip(&slip_inputs)
+            .zip(&long_tyre)
+            .take(nw)
+        {
+            if fz <= 0.0 || !lt.active {
                 // a tyre in the air relaxes its deflection
                 ws.slip_long = 0.0;
                 ws.slip_lat = 0.0;
                 continue;
             }
-            let spin = st.group_spin[m.group];
-            let vslip = vx - spin * radius;
-            let vref = vx.abs().max((spin * radius).abs());
-            let decay = 1.0 + h * vref / sigma;
-            let mut kx = (ws.slip_long - h * vslip / sigma) / decay;
-            let mut ky = (ws.slip_lat - h * vy / sigma) / decay;
+            let spin = ws.spin_rate;
+            let mut kx = lt.a + lt.b * spin;
+            let mut ky = (ws.slip_lat - h * vy / sigma) / lt.decay;
             let limit = if clamp < 0.0 {
                 tmeasy_sliding_slip(kx, ky, &spec.tyre)
             } else {

@@ -62,7 +62,7 @@ impl SoilLayout {
     #[inline]
     pub fn locate(&self, i: i64, j: i64) -> Option<(usize, usize)> {
         let (a, b) = (i + self.half, j + self.half);
-        let n = (2 * self.half + 1) as i64;
+        let n = 2 * self.half + 1;
         if a < 0 || b < 0 || a >= n || b >= n {
             return None;
         }

@@ -5,7 +5,7 @@ use std::sync::Arc;
 use verti_core::{Rng, Vec3};
 use verti_sim::spec::{Differential, VehicleSpec};
 use verti_sim::testing::{self, RoughSurface};
-use verti_sim::{Controls, Sim, SimError, SimState, start_pose, vehicles};
+use verti_sim::{Controls, Sim, SimState, start_pose, vehicles};
 use verti_world::{SoilParams, World};
 
 const G: f64 = 9.81;
