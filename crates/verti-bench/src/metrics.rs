@@ -23,7 +23,7 @@ impl Stats {
         self.var = (m2 + d * (x - self.mean)) / self.count as f64;
     }
 
-    pub fn from_iter(xs: impl IntoIterator<Item = f64>) -> Stats {
+    pub fn of(xs: impl IntoIterator<Item = f64>) -> Stats {
         let mut s = Stats::default();
         for x in xs {
             s.push(x);
@@ -75,7 +75,7 @@ mod tests {
 
     #[test]
     fn stats_match_definitions() {
-        let s = Stats::from_iter([1.0, 2.0, 3.0, 4.0]);
+        let s = Stats::of([1.0, 2.0, 3.0, 4.0]);
         assert_eq!(s.mean, 2.5);
         assert!((s.var - 1.25).abs() < 1e-12);
         assert_eq!(s.max, 4.0);

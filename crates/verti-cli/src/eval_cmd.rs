@@ -212,3 +212,53 @@ pub fn replay(a: ReplayArgs) -> CmdResult {
     );
     Ok(())
 }
+
+#[derive(Args)]
+pub struct ReportArgs {
+    /// Results: run directories written by `verti eval`, `.jsonl` files, or folders of runs.
+    #[arg(required = true)]
+    results: Vec<PathBuf>,
+    /// Output directory for report.md, report.html, summary.json and fig6.png.
+    #[arg(long, default_value = "report")]
+    out: PathBuf,
+    /// Print the summary as JSON instead of writing files.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Table I and Fig. 6 from one or more evaluation runs (several systems side by side).
+pub fn report(a: ReportArgs) -> CmdResult {
+    use verti_bench::report::{fig6_charts, html, load_results_from, markdown, summarize};
+    let loaded = load_results_from(&a.results)?;
+    for f in loaded.files.iter().filter(|f| !f.clean) {
+        eprintln!("warning: {}: dropped a torn last line (an interrupted run?)", f.path.display());
+    }
+    if loaded.results.is_empty() {
+        return Err("no trial results found in the given paths".into());
+    }
+    let summary = summarize(&loaded.results);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+        return Ok(());
+    }
+    std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
+    let panels: Vec<verti_render::Panel> = fig6_charts(&summary)
+        .into_iter()
+        .map(|p| verti_render::Panel {
+            title: p.title,
+            y_label: p.y_label,
+            y_max: p.y_max,
+            groups: p.groups,
+            series: p.series.into_iter().map(|x| verti_render::Series { name: x.name, values: x.values, errors: x.errors }).collect(),
+        })
+        .collect();
+    verti_render::grouped_bars_png(&panels, 4, &a.out.join("fig6.png"))?;
+    let md = markdown(&summary);
+    let write = |name: &str, text: &str| std::fs::write(a.out.join(name), text).map_err(|e| format!("{}: {e}", a.out.join(name).display()));
+    write("report.md", &format!("{md}\n![Fig. 6](fig6.png)\n"))?;
+    write("report.html", &html(&summary, &[("Fig. 6: success, traversal time, roll and pitch by elevation, terrain and density", "fig6.png")]))?;
+    write("summary.json", &serde_json::to_string_pretty(&summary)?)?;
+    println!("{md}");
+    println!("report written to {} (report.md, report.html, summary.json, fig6.png)", a.out.display());
+    Ok(())
+}

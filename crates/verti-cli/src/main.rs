@@ -36,6 +36,8 @@ enum Command {
     Eval(eval_cmd::EvalArgs),
     /// Draw one evaluated trial's trajectory over its world.
     Replay(eval_cmd::ReplayArgs),
+    /// Table I and Fig. 6 (Markdown, HTML, PNG, JSON) from evaluation results.
+    Report(eval_cmd::ReportArgs),
 }
 
 #[derive(Subcommand)]
@@ -68,6 +70,7 @@ fn main() -> ExitCode {
         Command::Systems(SystemsCommand::List) => eval_cmd::systems_list(),
         Command::Eval(a) => eval_cmd::eval(a),
         Command::Replay(a) => eval_cmd::replay(a),
+        Command::Report(a) => eval_cmd::report(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -109,6 +109,21 @@ impl Rng {
         libm::sqrt(-2.0 * libm::log(u1)) * libm::cos(std::f64::consts::TAU * u2)
     }
 
+    /// Two independent standard normal deviates (Marsaglia's polar method: one log and one
+    /// square root per pair, no trigonometry; about twice as fast as two `normal` calls).
+    /// Used where many samples are needed, e.g. MPPI noise.
+    pub fn normal_pair(&mut self) -> (f64, f64) {
+        loop {
+            let u = 2.0 * self.uniform() - 1.0;
+            let v = 2.0 * self.uniform() - 1.0;
+            let s = u * u + v * v;
+            if s > 0.0 && s < 1.0 {
+                let f = libm::sqrt(-2.0 * libm::log(s) / s);
+                return (u * f, v * f);
+            }
+        }
+    }
+
     /// Normal deviate with the given mean and standard deviation.
     pub fn gauss(&mut self, mean: f64, std: f64) -> f64 {
         mean + std * self.normal()
@@ -164,6 +179,16 @@ mod tests {
         assert!(mean.abs() < 0.01, "mean {mean}");
         assert!((var - 1.0).abs() < 0.01, "var {var}");
         let u: f64 = (0..n).map(|_| r.uniform()).sum::<f64>() / n as f64;
+        // pairs: both components standard normal and uncorrelated
+        let (mut sa, mut sb, mut sab) = (0.0, 0.0, 0.0);
+        for _ in 0..n {
+            let (a, b) = r.normal_pair();
+            sa += a * a;
+            sb += b * b;
+            sab += a * b;
+        }
+        let nf = n as f64;
+        assert!((sa / nf - 1.0).abs() < 0.01 && (sb / nf - 1.0).abs() < 0.01 && (sab / nf).abs() < 0.01);
         assert!((u - 0.5).abs() < 0.005);
     }
 
