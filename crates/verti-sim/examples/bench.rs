@@ -14,7 +14,14 @@ fn main() {
     } else {
         vehicles::all_builtin()
     };
-    let worlds = BenchWorlds::synthetic_for(&specs);
+    let worlds = if std::env::var("SYNTHETIC").is_ok() {
+        BenchWorlds::synthetic_for(&specs)
+    } else {
+        BenchWorlds::generated_for(&specs).expect("generated worlds")
+    };
+    for p in &worlds.pairs {
+        eprintln!("scale {}: rigid {} ({} obstacles, relief {:.1} m), soil {}", p.scale, p.rigid.meta.name, p.rigid.obstacles.len(), p.rigid.terrain.max_height() - p.rigid.terrain.min_height(), p.soil.meta.name);
+    }
     let report = bench(&worlds, &specs, seconds, runs);
     print!("{report}");
     if std::env::var("JSON").is_ok() {

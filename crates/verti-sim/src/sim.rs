@@ -1812,11 +1812,12 @@ impl Sim {
             if st.position.z - self.reach > oz1 || st.position.z + self.reach < oz0 {
                 continue;
             }
-            // The face-plane distance of the box centre bounds every box point's distance
-            // from below, so one query rules out most nearby obstacles.
+            // Separating planes: if the whole box lies outside one face plane of the rock (the
+            // box's support along the face normal), nothing touches; most nearby obstacles
+            // are ruled out this way before any per-point work.
             let fo = &self.fast_obstacles[k as usize];
-            let box_world = st.position + q.rotate(self.box_center);
-            if fo.signed_distance(box_world).0 > self.box_half.norm() {
+            let box_world = st.position + rm.mul_vec(self.box_center);
+            if fo.separated_from_box(box_world, &rm, self.box_half) {
                 continue;
             }
             // chassis points inside the obstacle
