@@ -56,6 +56,7 @@ fn static_sag_and_heave_frequency() {
         };
         let expected = load / k;
         let err = (wheel.compression - expected).abs() / expected;
+        println!("sag wheel {w}: {:.5} m vs m·g/k {expected:.5} m", wheel.compression);
         assert!(
             err < 0.02,
             "wheel {w}: sag {:.5} m, expected m·g/k = {expected:.5} m ({:.1} %)",
@@ -104,6 +105,7 @@ fn static_sag_and_heave_frequency() {
     let w2 = 0.5 * (tr - (tr * tr - 4.0 * det).sqrt());
     let expected = std::f64::consts::TAU / w2.sqrt();
     let err = (period - expected).abs() / expected;
+    println!("heave period {period:.4} s vs quarter-car {expected:.4} s");
     assert!(
         err < 0.05,
         "heave period {period:.4} s, quarter-car {expected:.4} s ({:.1} %)",
@@ -140,12 +142,14 @@ fn parked_on_slope_holds_below_friction_angle_and_slides_above() {
     for mu in [0.4f64, 0.7] {
         let critical = mu.atan().to_degrees();
         let (moved, speed) = parked(mu, critical - 1.5);
+        println!("μ {mu}: {:.1}° moved {moved:.4} m, speed {speed:.5}", critical - 1.5);
         assert!(
             moved.abs() < 0.01 && speed < 1e-3,
             "μ {mu}: at {:.1}° it moved {moved:.4} m, speed {speed:.4} m/s (should hold)",
             critical - 1.5
         );
         let (moved, speed) = parked(mu, critical + 1.5);
+        println!("μ {mu}: {:.1}° moved {moved:.4} m, speed {speed:.5}", critical + 1.5);
         assert!(
             moved < 0.0 && speed > 0.3,
             "μ {mu}: at {:.1}° it moved {moved:.3} m, speed {speed:.3} m/s (should slide down)",
@@ -239,6 +243,7 @@ fn tilt_table_rollover_angle() {
         let brake = Controls::new(0.0, 1.0, 0.0);
         let below = max_roll_on_side_slope(&spec, 0.95 * phi, 4.0, brake);
         let above = max_roll_on_side_slope(&spec, 1.05 * phi, 4.0, brake);
+        println!("{name}: φ {phi:.2}° (h {h:.4} m); max roll at 0.95φ {:.1}°, at 1.05φ {:.1}°", below.to_degrees(), above.to_degrees());
         assert!(
             below.to_degrees() < 0.95 * phi + 10.0,
             "{name}: at {:.1}° (0.95 φ, φ = {phi:.1}°) roll reached {:.1}°",
@@ -276,6 +281,7 @@ fn braking_distance_matches_friction() {
     let distance = st.com_position().x - x0;
     let expected = v0 * v0 / (2.0 * mu * G);
     let err = (distance - expected).abs() / expected;
+    println!("braking distance {distance:.3} m vs v²/2μg {expected:.3} m");
     assert!(
         err < 0.10,
         "stopped in {distance:.2} m, v²/(2μg) = {expected:.2} m ({:.1} %)",
@@ -322,6 +328,7 @@ fn rigid_wheel_sinkage_matches_bekker() {
         let expected = bekker_static_sinkage(load, 0.3, spec.axles[0].wheel.radius, &soil);
         let sinkage = spec.axles[0].wheel.radius - hub.z; // flat soil at z = 0
         let err = (sinkage - expected).abs() / expected;
+        println!("sinkage wheel {w}: {sinkage:.4} m vs Bekker {expected:.4} m");
         assert!(
             err < 0.10,
             "wheel {w}: sinkage {sinkage:.4} m, Bekker {expected:.4} m ({:.1} %)",
@@ -348,6 +355,7 @@ fn stuck_in_snow_on_a_slope_it_climbs_on_concrete() {
     let slope = 32f64.to_radians();
     let concrete = climb(testing::plane_world(1.0, slope, 0.0, 0.85));
     let snow = climb(testing::soil_world(1.0, SoilParams::SOFT, slope));
+    println!("32° climb in 15 s: concrete {concrete:.2} m, snow {snow:.2} m");
     assert!(
         concrete > 20.0,
         "on concrete it only climbed {concrete:.2} m"
@@ -410,6 +418,7 @@ fn low_speed_cornering_follows_ackermann() {
     let delta = steer * spec.steering.max_angle_deg.to_radians();
     let expected = (spec.axles[0].x - spec.axles[1].x) / delta.tan();
     let err = (radius - expected).abs() / expected;
+    println!("turn radius {radius:.3} m vs Ackermann {expected:.3} m");
     assert!(
         err < 0.05,
         "turn radius {radius:.2} m, Ackermann {expected:.2} m ({:.1} %)",
@@ -446,6 +455,7 @@ fn no_energy_gain_on_bumpy_terrain() {
             st.time()
         );
     }
+    println!("energy: start {e0:.1} J, end {:.1} J, largest rise {worst:.4} J (tolerance {tolerance:.2} J)", sim.energy(&st));
     assert!(
         sim.energy(&st) < e0,
         "energy did not decrease (worst rise {worst:.3} J)"
@@ -474,6 +484,7 @@ fn rock_stops_the_vehicle() {
         let front = sim.point_world(&st, Vec3::new(2.3, 0.0, 0.5));
         furthest = furthest.max(front.x);
     }
+    println!("rock: front reached {furthest:.3} m (face at {face} m), final speed {:.3} m/s", st.velocity_world().norm());
     assert!(
         furthest < face + 0.5,
         "the front reached x = {furthest:.2} m, the rock face is at {face} m"
@@ -498,6 +509,7 @@ fn side_slope_rollover_while_driving() {
     let drive = Controls::new(0.3, 0.0, 0.0);
     let below = max_roll_on_side_slope(&spec, 0.8 * phi, 6.0, drive);
     let above = max_roll_on_side_slope(&spec, 1.1 * phi, 6.0, drive);
+    println!("driving: max roll at 0.8φ {:.1}°, at 1.1φ {:.1}°", below.to_degrees(), above.to_degrees());
     assert!(
         below.to_degrees() < 0.8 * phi + 10.0,
         "at 0.8 φ = {:.1}° roll reached {:.1}°",
