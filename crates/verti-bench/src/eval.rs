@@ -133,6 +133,14 @@ pub fn read_results(path: &Path) -> Result<(Vec<TrialResult>, bool), EvalError> 
     Ok((out, clean))
 }
 
+/// Where per-step logs of trials go: `write` receives each finished trial with its log (the
+/// last `seconds` of it, or all of it for infinity) before the trial's result line is appended,
+/// so every recorded result has its log.
+pub struct StepLogSink<'a> {
+    pub seconds: f64,
+    pub write: &'a (dyn Fn(&TrialResult, &crate::episode::EpisodeLog) -> Result<(), String> + Sync),
+}
+
 /// Settings of one evaluation run.
 pub struct EvalSetup<'a> {
     pub worlds: &'a [Arc<World>],
@@ -144,6 +152,8 @@ pub struct EvalSetup<'a> {
     /// Overwrite an existing results file instead of refusing.
     pub force: bool,
     pub run: RunInfo,
+    /// Optional per-step logs.
+    pub step_log: Option<StepLogSink<'a>>,
 }
 
 /// Runs the selected tasks; returns all results of the run (earlier and new), sorted by task.
@@ -212,7 +222,16 @@ pub fn evaluate(
         todo.par_iter()
             .map(|&(wi, pair)| {
                 let mut system = make_system();
-                let r = run_episode(&setup.worlds[wi], setup.vehicle, pair, system.as_mut(), &setup.episode, None);
+                let r = match &setup.step_log {
+                    None => run_episode(&setup.worlds[wi], setup.vehicle, pair, system.as_mut(), &setup.episode, None),
+                    Some(sink) => {
+                        let mut log = crate::episode::EpisodeLog::default();
+                        let cfg = EpisodeConfig { log_seconds: Some(sink.seconds), ..setup.episode.clone() };
+                        let r = run_episode(&setup.worlds[wi], setup.vehicle, pair, system.as_mut(), &cfg, Some(&mut log));
+                        (sink.write)(&r, &log).map_err(EvalError::Argument)?;
+                        r
+                    }
+                };
                 let mut line = serde_json::to_string(&r).expect("results serialise");
                 line.push('\n');
                 {

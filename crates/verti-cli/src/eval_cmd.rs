@@ -77,6 +77,10 @@ pub struct EvalArgs {
     /// Run seed (systems with randomness derive their per-task seed from it).
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Write a per-step Parquet log of every trial to OUT/steps/: `last10` keeps the last 10 s
+    /// (what the failure-case dataset needs), `all` the whole trial.
+    #[arg(long, value_parser = ["last10", "all"])]
+    log_steps: Option<String>,
 }
 
 /// The default vehicle for a world scale.
@@ -118,6 +122,22 @@ pub fn eval(a: EvalArgs) -> CmdResult {
             seed: a.seed,
             max_time: a.max_time,
         },
+        step_log: None,
+    };
+    let steps_dir = out.join("steps");
+    let write_log = |r: &verti_bench::TrialResult, log: &EpisodeLog| {
+        let path = steps_dir.join(verti_log::log_file_name(r.task));
+        verti_log::write_steps(&path, r, &log.steps).map_err(|e| e.to_string())
+    };
+    let setup = EvalSetup {
+        step_log: match a.log_steps.as_deref() {
+            None => None,
+            Some(kind) => {
+                std::fs::create_dir_all(&steps_dir).map_err(|e| format!("{}: {e}", steps_dir.display()))?;
+                Some(verti_bench::eval::StepLogSink { seconds: if kind == "all" { f64::INFINITY } else { 10.0 }, write: &write_log })
+            }
+        },
+        ..setup
     };
     let total = verti_bench::eval::select_tasks(&worlds, &selection)?.len();
     let pb = bar(total as u64, &a.system);

@@ -38,6 +38,7 @@ fn setup<'a>(worlds: &'a [Arc<World>], vehicle: &'a verti_sim::VehicleSpec, out:
             seed: 0,
             max_time: 30.0,
         },
+        step_log: None,
     }
 }
 
