@@ -26,13 +26,23 @@ pub enum EvalError {
     #[error("{0}")]
     Argument(String),
     #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     #[error("{path}: line {line}: {problem}")]
-    Corrupt { path: PathBuf, line: usize, problem: String },
+    Corrupt {
+        path: PathBuf,
+        line: usize,
+        problem: String,
+    },
 }
 
 fn io(path: &Path) -> impl Fn(std::io::Error) -> EvalError + '_ {
-    move |source| EvalError::Io { path: path.to_path_buf(), source }
+    move |source| EvalError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
 }
 
 /// Parses a task selection like `1-1000`, `7`, `1,5,10-20` or `all` into sorted task numbers.
@@ -51,10 +61,16 @@ pub fn parse_tasks(spec: &str) -> Result<Vec<u32>, EvalError> {
             Some((a, b)) => (a.trim(), b.trim()),
             None => (part, part),
         };
-        let a: u32 = a.parse().map_err(|_| bad(format!("`{a}` is not a task number")))?;
-        let b: u32 = b.parse().map_err(|_| bad(format!("`{b}` is not a task number")))?;
+        let a: u32 = a
+            .parse()
+            .map_err(|_| bad(format!("`{a}` is not a task number")))?;
+        let b: u32 = b
+            .parse()
+            .map_err(|_| bad(format!("`{b}` is not a task number")))?;
         if a == 0 || b < a {
-            return Err(bad(format!("`{part}` is not an increasing range of task numbers starting at 1")));
+            return Err(bad(format!(
+                "`{part}` is not an increasing range of task numbers starting at 1"
+            )));
         }
         if b - a > 10_000_000 {
             return Err(bad(format!("`{part}` is too large")));
@@ -81,11 +97,22 @@ pub struct RunInfo {
 
 /// Resolves the selected task numbers against a set: all tasks of the set when `selection` is
 /// empty; otherwise each number must name a task of a world in the set.
-pub fn select_tasks(worlds: &[Arc<World>], selection: &[u32]) -> Result<Vec<(usize, u32)>, EvalError> {
+pub fn select_tasks(
+    worlds: &[Arc<World>],
+    selection: &[u32],
+) -> Result<Vec<(usize, u32)>, EvalError> {
     let mut all = Vec::new();
     for (wi, w) in worlds.iter().enumerate() {
         for t in &w.tasks {
-            all.push((TaskId { world: w.meta.index, pair: t.pair }.number(), wi, t.pair));
+            all.push((
+                TaskId {
+                    world: w.meta.index,
+                    pair: t.pair,
+                }
+                .number(),
+                wi,
+                t.pair,
+            ));
         }
     }
     all.sort();
@@ -102,7 +129,10 @@ pub fn select_tasks(worlds: &[Arc<World>], selection: &[u32]) -> Result<Vec<(usi
     }
     if !missing.is_empty() {
         let shown: Vec<String> = missing.iter().take(5).map(|n| n.to_string()).collect();
-        let (lo, hi) = (all.first().map_or(0, |a| a.0), all.last().map_or(0, |a| a.0));
+        let (lo, hi) = (
+            all.first().map_or(0, |a| a.0),
+            all.last().map_or(0, |a| a.0),
+        );
         return Err(EvalError::Argument(format!(
             "{} selected task(s) are not in this world set (e.g. {}); it has tasks {lo}..={hi} ({} tasks)",
             missing.len(),
@@ -127,7 +157,13 @@ pub fn read_results(path: &Path) -> Result<(Vec<TrialResult>, bool), EvalError> 
             Ok(r) => out.push(r),
             // only the last line may be torn (no trailing newline)
             Err(_) if i == lines.len() - 1 => clean = false,
-            Err(e) => return Err(EvalError::Corrupt { path: path.to_path_buf(), line: i + 1, problem: e.to_string() }),
+            Err(e) => {
+                return Err(EvalError::Corrupt {
+                    path: path.to_path_buf(),
+                    line: i + 1,
+                    problem: e.to_string(),
+                });
+            }
         }
     }
     Ok((out, clean))
@@ -181,8 +217,11 @@ pub fn evaluate(
             )));
         }
         let text = std::fs::read_to_string(&run_path).map_err(io(&run_path))?;
-        let before: RunInfo = serde_json::from_str(&text)
-            .map_err(|e| EvalError::Corrupt { path: run_path.clone(), line: 1, problem: e.to_string() })?;
+        let before: RunInfo = serde_json::from_str(&text).map_err(|e| EvalError::Corrupt {
+            path: run_path.clone(),
+            line: 1,
+            problem: e.to_string(),
+        })?;
         if before != setup.run {
             return Err(EvalError::Argument(format!(
                 "cannot resume: {} was made with different settings ({before:?}), now {:?}",
@@ -204,30 +243,64 @@ pub fn evaluate(
     } else {
         std::fs::write(&results_path, "").map_err(io(&results_path))?;
     }
-    std::fs::write(&run_path, serde_json::to_string_pretty(&setup.run).expect("run info serialises")).map_err(io(&run_path))?;
+    std::fs::write(
+        &run_path,
+        serde_json::to_string_pretty(&setup.run).expect("run info serialises"),
+    )
+    .map_err(io(&run_path))?;
 
     let done: BTreeSet<u32> = previous.iter().map(|r| r.task).collect();
     let todo: Vec<(usize, u32)> = tasks
         .into_iter()
-        .filter(|&(wi, pair)| !done.contains(&TaskId { world: setup.worlds[wi].meta.index, pair }.number()))
+        .filter(|&(wi, pair)| {
+            !done.contains(
+                &TaskId {
+                    world: setup.worlds[wi].meta.index,
+                    pair,
+                }
+                .number(),
+            )
+        })
         .collect();
 
-    let file = std::fs::OpenOptions::new().append(true).open(&results_path).map_err(io(&results_path))?;
+    let file = std::fs::OpenOptions::new()
+        .append(true)
+        .open(&results_path)
+        .map_err(io(&results_path))?;
     let sink = Mutex::new(file);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(setup.jobs)
         .build()
-        .map_err(|e| EvalError::Argument(format!("cannot start {} worker threads: {e}", setup.jobs)))?;
+        .map_err(|e| {
+            EvalError::Argument(format!("cannot start {} worker threads: {e}", setup.jobs))
+        })?;
     let fresh: Result<Vec<TrialResult>, EvalError> = pool.install(|| {
         todo.par_iter()
             .map(|&(wi, pair)| {
                 let mut system = make_system();
                 let r = match &setup.step_log {
-                    None => run_episode(&setup.worlds[wi], setup.vehicle, pair, system.as_mut(), &setup.episode, None),
+                    None => run_episode(
+                        &setup.worlds[wi],
+                        setup.vehicle,
+                        pair,
+                        system.as_mut(),
+                        &setup.episode,
+                        None,
+                    ),
                     Some(sink) => {
                         let mut log = crate::episode::EpisodeLog::default();
-                        let cfg = EpisodeConfig { log_seconds: Some(sink.seconds), ..setup.episode.clone() };
-                        let r = run_episode(&setup.worlds[wi], setup.vehicle, pair, system.as_mut(), &cfg, Some(&mut log));
+                        let cfg = EpisodeConfig {
+                            log_seconds: Some(sink.seconds),
+                            ..setup.episode.clone()
+                        };
+                        let r = run_episode(
+                            &setup.worlds[wi],
+                            setup.vehicle,
+                            pair,
+                            system.as_mut(),
+                            &cfg,
+                            Some(&mut log),
+                        );
                         (sink.write)(&r, &log).map_err(EvalError::Argument)?;
                         r
                     }
@@ -236,7 +309,9 @@ pub fn evaluate(
                 line.push('\n');
                 {
                     let mut f = sink.lock().unwrap_or_else(|p| p.into_inner());
-                    f.write_all(line.as_bytes()).and_then(|_| f.flush()).map_err(io(&results_path))?;
+                    f.write_all(line.as_bytes())
+                        .and_then(|_| f.flush())
+                        .map_err(io(&results_path))?;
                 }
                 on_result(&r);
                 Ok(r)

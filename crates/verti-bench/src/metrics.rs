@@ -88,6 +88,10 @@ mod tests {
         let mut a = AngleStats::default();
         a.push_rad(-std::f64::consts::FRAC_PI_2);
         a.push_rad(std::f64::consts::FRAC_PI_2);
-        assert!(a.raw.mean.abs() < 1e-12 && (a.abs.mean - 90.0).abs() < 1e-12 && (a.abs.max - 90.0).abs() < 1e-12);
+        assert!(
+            a.raw.mean.abs() < 1e-12
+                && (a.abs.mean - 90.0).abs() < 1e-12
+                && (a.abs.max - 90.0).abs() < 1e-12
+        );
     }
 }

@@ -90,7 +90,10 @@ impl<'a> Observation<'a> {
         let ahead = (half - row as f64) * spec.resolution;
         let left = (half - col as f64) * spec.resolution;
         let (s, c) = self.pose.yaw.sin_cos();
-        (self.pose.x + ahead * c - left * s, self.pose.y + ahead * s + left * c)
+        (
+            self.pose.x + ahead * c - left * s,
+            self.pose.y + ahead * s + left * c,
+        )
     }
 
     fn crop<T>(&self, spec: CropSpec, f: impl Fn(f64, f64) -> T) -> Crop<T> {
@@ -124,7 +127,8 @@ impl<'a> Observation<'a> {
             .iter()
             .filter(|o| {
                 let p = o.position();
-                ((p.x - self.pose.x).powi(2) + (p.y - self.pose.y).powi(2)).sqrt() < reach + o.radius_xy()
+                ((p.x - self.pose.x).powi(2) + (p.y - self.pose.y).powi(2)).sqrt()
+                    < reach + o.radius_xy()
             })
             .collect();
         // the bounding-circle test rejects almost every (cell, obstacle) pair before the
@@ -135,7 +139,8 @@ impl<'a> Observation<'a> {
                     || near.iter().any(|o| {
                         let p = o.position();
                         let r = o.radius_xy();
-                        (p.x - x).powi(2) + (p.y - y).powi(2) <= r * r && o.footprint_distance(x, y) <= 0.0
+                        (p.x - x).powi(2) + (p.y - y).powi(2) <= r * r
+                            && o.footprint_distance(x, y) <= 0.0
                     }),
             )
         })
@@ -159,9 +164,22 @@ impl<'a> Observation<'a> {
 
 /// An observation of a vehicle standing at `xy` with heading `yaw` (for tests and benchmarks of
 /// systems outside an episode).
-pub fn test_observation<'a>(world: &'a World, xy: [f64; 2], yaw: f64, goal: [f64; 2], path: &'a [[f64; 2]]) -> Observation<'a> {
+pub fn test_observation<'a>(
+    world: &'a World,
+    xy: [f64; 2],
+    yaw: f64,
+    goal: [f64; 2],
+    path: &'a [[f64; 2]],
+) -> Observation<'a> {
     let z = world.terrain.height_at(xy[0], xy[1]);
-    let pose = Pose6 { x: xy[0], y: xy[1], z, roll: 0.0, pitch: 0.0, yaw };
+    let pose = Pose6 {
+        x: xy[0],
+        y: xy[1],
+        z,
+        roll: 0.0,
+        pitch: 0.0,
+        yaw,
+    };
     Observation::new(world, 0.0, pose, Vec3::ZERO, Vec3::ZERO, 0.0, goal, path)
 }
 
@@ -174,19 +192,56 @@ mod tests {
     fn crops_are_heading_aligned() {
         // a plane rising to the east: z = 0.1 x
         let world = testing::plane_world(1.0, 0.1f64.atan(), 0.0, 0.8);
-        let spec = CropSpec { size: 5, resolution: 1.0 };
-        let pose = Pose6 { x: 0.0, y: 0.0, z: 0.0, roll: 0.0, pitch: 0.0, yaw: 0.0 };
-        let obs = Observation::new(&world, 0.0, pose, Vec3::ZERO, Vec3::ZERO, 0.0, [10.0, 0.0], &[]);
+        let spec = CropSpec {
+            size: 5,
+            resolution: 1.0,
+        };
+        let pose = Pose6 {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            roll: 0.0,
+            pitch: 0.0,
+            yaw: 0.0,
+        };
+        let obs = Observation::new(
+            &world,
+            0.0,
+            pose,
+            Vec3::ZERO,
+            Vec3::ZERO,
+            0.0,
+            [10.0, 0.0],
+            &[],
+        );
         let crop = obs.elevation_crop(spec);
         let here = crop.get(2, 2);
         // facing east: row 0 is 2 m ahead (x = 2), row 4 is 2 m behind
-        assert!((crop.get(0, 2) - here - 0.2).abs() < 1e-9 && (crop.get(4, 2) - here + 0.2).abs() < 1e-9);
+        assert!(
+            (crop.get(0, 2) - here - 0.2).abs() < 1e-9
+                && (crop.get(4, 2) - here + 0.2).abs() < 1e-9
+        );
         // facing north: the robot's left is west, so column 0 is lower on this east-rising plane
-        let pose_n = Pose6 { yaw: std::f64::consts::FRAC_PI_2, ..pose };
-        let obs = Observation::new(&world, 0.0, pose_n, Vec3::ZERO, Vec3::ZERO, 0.0, [10.0, 0.0], &[]);
+        let pose_n = Pose6 {
+            yaw: std::f64::consts::FRAC_PI_2,
+            ..pose
+        };
+        let obs = Observation::new(
+            &world,
+            0.0,
+            pose_n,
+            Vec3::ZERO,
+            Vec3::ZERO,
+            0.0,
+            [10.0, 0.0],
+            &[],
+        );
         let crop = obs.elevation_crop(spec);
         let here = crop.get(2, 2);
-        assert!((crop.get(2, 0) - here + 0.2).abs() < 1e-9, "column 0 is the robot's left = west");
+        assert!(
+            (crop.get(2, 0) - here + 0.2).abs() < 1e-9,
+            "column 0 is the robot's left = west"
+        );
         assert!((crop.get(2, 4) - here - 0.2).abs() < 1e-9);
     }
 }

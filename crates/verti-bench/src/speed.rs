@@ -21,7 +21,11 @@ impl SpeedController {
     pub fn controls(&self, target: f64, measured: f64, steering: f64) -> Controls {
         let u = (self.kp * (target - measured)).clamp(-1.0, 1.0);
         let steering = steering.clamp(-1.0, 1.0);
-        if u > 0.0 { Controls::new(u, 0.0, steering) } else { Controls::new(0.0, -u, steering) }
+        if u > 0.0 {
+            Controls::new(u, 0.0, steering)
+        } else {
+            Controls::new(0.0, -u, steering)
+        }
     }
 }
 

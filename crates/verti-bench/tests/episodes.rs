@@ -29,8 +29,14 @@ impl MobilitySystem for Scripted {
 fn flat_task_world() -> Arc<World> {
     let mut w = testing::flat_world(1.0, 0.8);
     w.meta.index = 1;
-    w.tasks = vec![Task { pair: 0, start: [-40.0, 0.0], goal: [40.0, 0.0] }];
-    w.paths = vec![GlobalPath { points: vec![[-40.0, 0.0], [40.0, 0.0]] }];
+    w.tasks = vec![Task {
+        pair: 0,
+        start: [-40.0, 0.0],
+        goal: [40.0, 0.0],
+    }];
+    w.paths = vec![GlobalPath {
+        points: vec![[-40.0, 0.0], [40.0, 0.0]],
+    }];
     Arc::new(w)
 }
 
@@ -43,7 +49,11 @@ fn run(world: &Arc<World>, action: Action, cfg: &EpisodeConfig) -> verti_bench::
 #[test]
 fn braking_in_place_is_stuck_after_ten_seconds() {
     let w = flat_task_world();
-    let r = run(&w, Action::LowLevel(Controls::new(0.0, 1.0, 0.0)), &EpisodeConfig::default());
+    let r = run(
+        &w,
+        Action::LowLevel(Controls::new(0.0, 1.0, 0.0)),
+        &EpisodeConfig::default(),
+    );
     assert_eq!(r.outcome, Outcome::Stuck);
     // the window is full once a sample 10 s old exists; samples are 0.1 s apart
     assert!((10.0..=10.2).contains(&r.time), "{}", r.time);
@@ -58,7 +68,14 @@ fn braking_in_place_is_stuck_after_ten_seconds() {
 #[test]
 fn driving_straight_reaches_the_goal_in_the_expected_time() {
     let w = flat_task_world();
-    let r = run(&w, Action::HighLevel { speed: 5.0, steering: 0.0 }, &EpisodeConfig::default());
+    let r = run(
+        &w,
+        Action::HighLevel {
+            speed: 5.0,
+            steering: 0.0,
+        },
+        &EpisodeConfig::default(),
+    );
     assert_eq!(r.outcome, Outcome::Success, "{r:?}");
     // 70 m (80 m less the 10 m success radius) at 5 m/s is 14 s, plus a few seconds to speed up
     let t = r.traversal_time.unwrap();
@@ -72,16 +89,48 @@ fn driving_straight_reaches_the_goal_in_the_expected_time() {
 fn reference_rules_call_slow_driving_stuck_but_the_paper_does_not() {
     let w = flat_task_world();
     // 1.5 m/s: 15 m per 10 s, so not stuck by the paper; under 2 m/s, so stuck for the reference
-    let action = Action::HighLevel { speed: 1.5, steering: 0.0 };
-    let paper = run(&w, action, &EpisodeConfig { max_time: 20.0, ..Default::default() });
+    let action = Action::HighLevel {
+        speed: 1.5,
+        steering: 0.0,
+    };
+    let paper = run(
+        &w,
+        action,
+        &EpisodeConfig {
+            max_time: 20.0,
+            ..Default::default()
+        },
+    );
     assert_eq!(paper.outcome, Outcome::Timeout);
-    let reference = run(&w, action, &EpisodeConfig { rules: Rules::VertiBench, max_time: 20.0, ..Default::default() });
+    let reference = run(
+        &w,
+        action,
+        &EpisodeConfig {
+            rules: Rules::VertiBench,
+            max_time: 20.0,
+            ..Default::default()
+        },
+    );
     assert_eq!(reference.outcome, Outcome::Stuck);
-    assert!((10.0..=10.5).contains(&reference.time), "{}", reference.time);
+    assert!(
+        (10.0..=10.5).contains(&reference.time),
+        "{}",
+        reference.time
+    );
     // and the reference's 8 m 3-D sphere is stricter than the paper's 10 m circle
-    let fast = Action::HighLevel { speed: 5.0, steering: 0.0 };
+    let fast = Action::HighLevel {
+        speed: 5.0,
+        steering: 0.0,
+    };
     let p = run(&w, fast, &EpisodeConfig::default());
-    let v = run(&w, fast, &EpisodeConfig { rules: Rules::VertiBench, ..Default::default() });
+    let v = run(
+        &w,
+        fast,
+        &EpisodeConfig {
+            rules: Rules::VertiBench,
+            ..Default::default()
+        },
+    );
     assert_eq!((p.outcome, v.outcome), (Outcome::Success, Outcome::Success));
     assert!(v.traversal_time.unwrap() > p.traversal_time.unwrap());
     assert!(v.final_distance < 8.0);
@@ -90,14 +139,34 @@ fn reference_rules_call_slow_driving_stuck_but_the_paper_does_not() {
 #[test]
 fn a_nan_action_ends_the_trial_with_a_clear_error() {
     let w = flat_task_world();
-    let r = run(&w, Action::HighLevel { speed: f64::NAN, steering: 0.0 }, &EpisodeConfig::default());
+    let r = run(
+        &w,
+        Action::HighLevel {
+            speed: f64::NAN,
+            steering: 0.0,
+        },
+        &EpisodeConfig::default(),
+    );
     assert_eq!(r.outcome, Outcome::Error);
     let msg = r.error.unwrap();
-    assert!(msg.contains("invalid action") && msg.contains("NaN"), "{msg}");
-    let r = run(&w, Action::LowLevel(Controls::new(2.0, 0.0, 0.0)), &EpisodeConfig::default());
+    assert!(
+        msg.contains("invalid action") && msg.contains("NaN"),
+        "{msg}"
+    );
+    let r = run(
+        &w,
+        Action::LowLevel(Controls::new(2.0, 0.0, 0.0)),
+        &EpisodeConfig::default(),
+    );
     assert_eq!(r.outcome, Outcome::Error);
     let spec = vehicles::builtin("hmmwv").unwrap();
-    let mut s = Scripted { action: Action::HighLevel { speed: 1.0, steering: 0.0 }, rate: 20.0 };
+    let mut s = Scripted {
+        action: Action::HighLevel {
+            speed: 1.0,
+            steering: 0.0,
+        },
+        rate: 20.0,
+    };
     let r = run_episode(&w, &spec, 7, &mut s, &EpisodeConfig::default(), None);
     assert!(r.error.unwrap().contains("no pair 7"));
 }
@@ -108,10 +177,23 @@ fn rolling_over_on_a_steep_side_slope_is_classified_rollover() {
     // static rollover angle (tan φ = t / 2h, about 45°), so it must tip over.
     let mut w = testing::plane_world(1.0, 0.0, 48f64.to_radians(), 1.0);
     w.meta.index = 1;
-    w.tasks = vec![Task { pair: 0, start: [-40.0, 0.0], goal: [40.0, 0.0] }];
-    w.paths = vec![GlobalPath { points: vec![[-40.0, 0.0], [40.0, 0.0]] }];
+    w.tasks = vec![Task {
+        pair: 0,
+        start: [-40.0, 0.0],
+        goal: [40.0, 0.0],
+    }];
+    w.paths = vec![GlobalPath {
+        points: vec![[-40.0, 0.0], [40.0, 0.0]],
+    }];
     let w = Arc::new(w);
-    let r = run(&w, Action::HighLevel { speed: 6.0, steering: -1.0 }, &EpisodeConfig::default());
+    let r = run(
+        &w,
+        Action::HighLevel {
+            speed: 6.0,
+            steering: -1.0,
+        },
+        &EpisodeConfig::default(),
+    );
     assert_eq!(r.outcome, Outcome::Rollover, "{r:?}");
     assert!(r.final_roll > 30.0 && r.roll.abs.max > 30.0);
 }
@@ -121,9 +203,19 @@ fn the_log_keeps_the_last_seconds() {
     let w = flat_task_world();
     let spec = vehicles::builtin("hmmwv").unwrap();
     // 1.5 m/s for 40 s: a timeout, long enough for the log to be trimmed
-    let mut s = Scripted { action: Action::HighLevel { speed: 1.5, steering: 0.0 }, rate: 20.0 };
+    let mut s = Scripted {
+        action: Action::HighLevel {
+            speed: 1.5,
+            steering: 0.0,
+        },
+        rate: 20.0,
+    };
     let mut log = EpisodeLog::default();
-    let cfg = EpisodeConfig { log_seconds: Some(10.0), max_time: 40.0, ..Default::default() };
+    let cfg = EpisodeConfig {
+        log_seconds: Some(10.0),
+        max_time: 40.0,
+        ..Default::default()
+    };
     let r = run_episode(&w, &spec, 0, &mut s, &cfg, Some(&mut log));
     assert_eq!(r.outcome, Outcome::Timeout);
     let first = log.steps.first().unwrap().t;
@@ -135,5 +227,9 @@ fn the_log_keeps_the_last_seconds() {
     assert!(first <= r.time - 10.0 + dt + 1e-9, "{first}");
     assert!(first >= r.time - 10.0 - 10.25, "{first}");
     // consecutive, no gaps
-    assert!(log.steps.windows(2).all(|p| (p[1].t - p[0].t - dt).abs() < 1e-9));
+    assert!(
+        log.steps
+            .windows(2)
+            .all(|p| (p[1].t - p[0].t - dt).abs() < 1e-9)
+    );
 }

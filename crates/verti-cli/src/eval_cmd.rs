@@ -15,15 +15,23 @@ pub fn systems_list() -> CmdResult {
     for s in verti_systems::list() {
         println!("{}  {}", s.name, s.summary);
         for p in &s.params {
-            println!("    {:<15} {:>8}   [{}, {}]  {}", p.name, p.default, p.min, p.max, p.doc);
+            println!(
+                "    {:<15} {:>8}   [{}, {}]  {}",
+                p.name, p.default, p.min, p.max, p.doc
+            );
         }
     }
     Ok(())
 }
 
 fn parse_param(s: &str) -> Result<(String, f64), String> {
-    let (k, v) = s.split_once('=').ok_or_else(|| format!("parameter `{s}` must look like name=value"))?;
-    let v: f64 = v.trim().parse().map_err(|_| format!("parameter `{s}`: `{v}` is not a number"))?;
+    let (k, v) = s
+        .split_once('=')
+        .ok_or_else(|| format!("parameter `{s}` must look like name=value"))?;
+    let v: f64 = v
+        .trim()
+        .parse()
+        .map_err(|_| format!("parameter `{s}`: `{v}` is not a number"))?;
     Ok((k.trim().to_string(), v))
 }
 
@@ -97,13 +105,23 @@ fn default_vehicle(scale: f64) -> &'static str {
 pub fn eval(a: EvalArgs) -> CmdResult {
     verti_systems::registry::resolve_params(&a.system, &a.params)?;
     let selection = parse_tasks(&a.tasks)?;
-    let vehicle_name = a.vehicle.clone().unwrap_or_else(|| default_vehicle(a.scale).to_string());
+    let vehicle_name = a
+        .vehicle
+        .clone()
+        .unwrap_or_else(|| default_vehicle(a.scale).to_string());
     let vehicle = load_vehicle(&vehicle_name)?;
     let set = load_set_with_progress(&a.worlds, a.scale)?;
     let worlds: Vec<Arc<World>> = set.worlds.into_iter().map(Arc::new).collect();
-    let out = a.out.unwrap_or_else(|| PathBuf::from("results").join(format!("{}-{}", a.system, set.name)));
+    let out = a
+        .out
+        .unwrap_or_else(|| PathBuf::from("results").join(format!("{}-{}", a.system, set.name)));
     let jobs = a.jobs.unwrap_or_else(rayon::current_num_threads);
-    let episode = EpisodeConfig { rules: a.rules, max_time: a.max_time, seed: a.seed, ..Default::default() };
+    let episode = EpisodeConfig {
+        rules: a.rules,
+        max_time: a.max_time,
+        seed: a.seed,
+        ..Default::default()
+    };
     let setup = EvalSetup {
         worlds: &worlds,
         vehicle: &vehicle,
@@ -133,8 +151,12 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         step_log: match a.log_steps.as_deref() {
             None => None,
             Some(kind) => {
-                std::fs::create_dir_all(&steps_dir).map_err(|e| format!("{}: {e}", steps_dir.display()))?;
-                Some(verti_bench::eval::StepLogSink { seconds: if kind == "all" { f64::INFINITY } else { 10.0 }, write: &write_log })
+                std::fs::create_dir_all(&steps_dir)
+                    .map_err(|e| format!("{}: {e}", steps_dir.display()))?;
+                Some(verti_bench::eval::StepLogSink {
+                    seconds: if kind == "all" { f64::INFINITY } else { 10.0 },
+                    write: &write_log,
+                })
             }
         },
         ..setup
@@ -165,9 +187,23 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         100.0 * count(Outcome::Error) as f64 / n,
     );
     let sim_seconds: f64 = results.iter().map(|r| r.time).sum();
-    println!("simulated {:.0} s in {:.1} s of wall time; results in {}", sim_seconds, wall, out.join("results.jsonl").display());
-    for r in results.iter().filter(|r| r.outcome == Outcome::Error).take(5) {
-        println!("  task {} ({}): {}", r.task, r.world_name, r.error.as_deref().unwrap_or("?"));
+    println!(
+        "simulated {:.0} s in {:.1} s of wall time; results in {}",
+        sim_seconds,
+        wall,
+        out.join("results.jsonl").display()
+    );
+    for r in results
+        .iter()
+        .filter(|r| r.outcome == Outcome::Error)
+        .take(5)
+    {
+        println!(
+            "  task {} ({}): {}",
+            r.task,
+            r.world_name,
+            r.error.as_deref().unwrap_or("?")
+        );
     }
     Ok(())
 }
@@ -191,20 +227,42 @@ pub struct ReplayArgs {
 /// its trajectory over the world, coloured by speed, with the failure point marked.
 pub fn replay(a: ReplayArgs) -> CmdResult {
     let run_path = a.result.join(RUN_FILE);
-    let run: RunInfo = serde_json::from_str(&std::fs::read_to_string(&run_path).map_err(|e| format!("{}: {e}", run_path.display()))?)
-        .map_err(|e| format!("{}: {e}", run_path.display()))?;
+    let run: RunInfo = serde_json::from_str(
+        &std::fs::read_to_string(&run_path).map_err(|e| format!("{}: {e}", run_path.display()))?,
+    )
+    .map_err(|e| format!("{}: {e}", run_path.display()))?;
     let (results, _) = read_results(&a.result.join(verti_bench::eval::RESULTS_FILE))?;
-    let recorded = results
-        .iter()
-        .find(|r| r.task == a.task)
-        .ok_or_else(|| format!("task {} is not in {} ({} results)", a.task, a.result.display(), results.len()))?;
+    let recorded = results.iter().find(|r| r.task == a.task).ok_or_else(|| {
+        format!(
+            "task {} is not in {} ({} results)",
+            a.task,
+            a.result.display(),
+            results.len()
+        )
+    })?;
     let vehicle = load_vehicle(&run.vehicle)?;
     let id = verti_world::TaskId::from_number(a.task).ok_or("task numbers start at 1")?;
-    let world = Arc::new(verti_world::sets::resolve_world(&format!("{}:{}", run.worlds, id.world), run.scale)?);
+    let world = Arc::new(verti_world::sets::resolve_world(
+        &format!("{}:{}", run.worlds, id.world),
+        run.scale,
+    )?);
     let mut system = verti_systems::create(&run.system, &run.params)?;
-    let cfg = EpisodeConfig { rules: run.rules, max_time: run.max_time, seed: run.seed, log_seconds: Some(f64::INFINITY), ..Default::default() };
+    let cfg = EpisodeConfig {
+        rules: run.rules,
+        max_time: run.max_time,
+        seed: run.seed,
+        log_seconds: Some(f64::INFINITY),
+        ..Default::default()
+    };
     let mut log = EpisodeLog::default();
-    let replayed = run_episode(&world, &vehicle, id.pair, system.as_mut(), &cfg, Some(&mut log));
+    let replayed = run_episode(
+        &world,
+        &vehicle,
+        id.pair,
+        system.as_mut(),
+        &cfg,
+        Some(&mut log),
+    );
     if replayed.outcome != recorded.outcome || (replayed.time - recorded.time).abs() > 1e-9 {
         eprintln!(
             "warning: the replay ended differently ({:?} at {:.2} s) from the recorded trial ({:?} at {:.2} s)",
@@ -212,11 +270,24 @@ pub fn replay(a: ReplayArgs) -> CmdResult {
         );
     }
     let points: Vec<[f64; 2]> = log.steps.iter().map(|s| [s.x, s.y]).collect();
-    let speeds: Vec<f64> = log.steps.iter().map(|s| (s.vx * s.vx + s.vy * s.vy + s.vz * s.vz).sqrt()).collect();
-    let options = verti_render::RenderOptions { pixels_per_cell: a.px_per_cell, pairs: Some(vec![id.pair]), ..Default::default() };
+    let speeds: Vec<f64> = log
+        .steps
+        .iter()
+        .map(|s| (s.vx * s.vx + s.vy * s.vy + s.vz * s.vz).sqrt())
+        .collect();
+    let options = verti_render::RenderOptions {
+        pixels_per_cell: a.px_per_cell,
+        pairs: Some(vec![id.pair]),
+        ..Default::default()
+    };
     let mut img = verti_render::render_world(&world, &options)?;
-    let failure = (replayed.outcome != Outcome::Success).then(|| points.last().copied()).flatten();
-    let style = verti_render::TrajectoryStyle { failure, ..Default::default() };
+    let failure = (replayed.outcome != Outcome::Success)
+        .then(|| points.last().copied())
+        .flatten();
+    let style = verti_render::TrajectoryStyle {
+        failure,
+        ..Default::default()
+    };
     verti_render::draw_trajectory(&mut img, &points, &speeds, &style)?;
     ensure_parent(&a.out)?;
     img.save_png(&a.out)?;
@@ -251,7 +322,10 @@ pub fn report(a: ReportArgs) -> CmdResult {
     use verti_bench::report::{fig6_charts, html, load_results_from, markdown, summarize};
     let loaded = load_results_from(&a.results)?;
     for f in loaded.files.iter().filter(|f| !f.clean) {
-        eprintln!("warning: {}: dropped a torn last line (an interrupted run?)", f.path.display());
+        eprintln!(
+            "warning: {}: dropped a torn last line (an interrupted run?)",
+            f.path.display()
+        );
     }
     if loaded.results.is_empty() {
         return Err("no trial results found in the given paths".into());
@@ -269,16 +343,39 @@ pub fn report(a: ReportArgs) -> CmdResult {
             y_label: p.y_label,
             y_max: p.y_max,
             groups: p.groups,
-            series: p.series.into_iter().map(|x| verti_render::Series { name: x.name, values: x.values, errors: x.errors }).collect(),
+            series: p
+                .series
+                .into_iter()
+                .map(|x| verti_render::Series {
+                    name: x.name,
+                    values: x.values,
+                    errors: x.errors,
+                })
+                .collect(),
         })
         .collect();
     verti_render::grouped_bars_png(&panels, 4, &a.out.join("fig6.png"))?;
     let md = markdown(&summary);
-    let write = |name: &str, text: &str| std::fs::write(a.out.join(name), text).map_err(|e| format!("{}: {e}", a.out.join(name).display()));
+    let write = |name: &str, text: &str| {
+        std::fs::write(a.out.join(name), text)
+            .map_err(|e| format!("{}: {e}", a.out.join(name).display()))
+    };
     write("report.md", &format!("{md}\n![Fig. 6](fig6.png)\n"))?;
-    write("report.html", &html(&summary, &[("Fig. 6: success, traversal time, roll and pitch by elevation, terrain and density", "fig6.png")]))?;
+    write(
+        "report.html",
+        &html(
+            &summary,
+            &[(
+                "Fig. 6: success, traversal time, roll and pitch by elevation, terrain and density",
+                "fig6.png",
+            )],
+        ),
+    )?;
     write("summary.json", &serde_json::to_string_pretty(&summary)?)?;
     println!("{md}");
-    println!("report written to {} (report.md, report.html, summary.json, fig6.png)", a.out.display());
+    println!(
+        "report written to {} (report.md, report.html, summary.json, fig6.png)",
+        a.out.display()
+    );
     Ok(())
 }

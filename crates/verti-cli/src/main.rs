@@ -61,7 +61,9 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
         // The global pool can only be built once; failing here means it already exists.
-        let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
     }
     let result = match cli.command {
         Command::World(cmd) => world_cmd::run(cmd),

@@ -31,7 +31,10 @@ pub fn load_vehicle(name: &str) -> Result<VehicleSpec, Box<dyn std::error::Error
 pub fn run_vehicle(cmd: VehicleCommand) -> CmdResult {
     match cmd {
         VehicleCommand::List => {
-            println!("{:<8} {:>7} {:>9} {:>7} {:>6}  description", "name", "scale", "mass kg", "wheels", "track");
+            println!(
+                "{:<8} {:>7} {:>9} {:>7} {:>6}  description",
+                "name", "scale", "mass kg", "wheels", "track"
+            );
             for spec in vehicles::all_builtin() {
                 let wheels: usize = spec.axles.len() * 2;
                 println!(
@@ -50,7 +53,10 @@ pub fn run_vehicle(cmd: VehicleCommand) -> CmdResult {
             if yaml {
                 match vehicles::builtin_yaml(&name) {
                     Some(t) => print!("{t}"),
-                    None => print!("{}", std::fs::read_to_string(&name).map_err(|e| format!("{name}: {e}"))?),
+                    None => print!(
+                        "{}",
+                        std::fs::read_to_string(&name).map_err(|e| format!("{name}: {e}"))?
+                    ),
                 }
                 return Ok(());
             }
@@ -128,23 +134,32 @@ pub fn run_sim(cmd: SimCommand) -> CmdResult {
         SimCommand::Soak(a) => {
             let specs = vehicles_arg(&a.vehicle)?;
             let set = load_set_with_progress(&a.worlds, 1.0)?;
-            let mut worlds: Vec<Arc<verti_world::World>> = set.worlds.into_iter().map(Arc::new).collect();
+            let mut worlds: Vec<Arc<verti_world::World>> =
+                set.worlds.into_iter().map(Arc::new).collect();
             // smaller vehicles get the set regenerated at their scale when it is the built-in one
             for spec in &specs {
-                if (spec.scale - 1.0).abs() > 1e-9 && verti_world::sets::builtin_config(&a.worlds, spec.scale).is_some() {
+                if (spec.scale - 1.0).abs() > 1e-9
+                    && verti_world::sets::builtin_config(&a.worlds, spec.scale).is_some()
+                {
                     let scaled = load_set_with_progress(&a.worlds, spec.scale)?;
                     worlds.extend(scaled.worlds.into_iter().map(Arc::new));
                 }
             }
             let pb = bar(a.steps, "soak");
-            let report = verti_sim::soak(&worlds, &specs, a.steps, a.seed, |done| pb.set_position(done));
+            let report = verti_sim::soak(&worlds, &specs, a.steps, a.seed, |done| {
+                pb.set_position(done)
+            });
             pb.finish_and_clear();
             if a.json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else {
                 print!("{report}");
             }
-            if report.failures.is_empty() { Ok(()) } else { Err(format!("{} episodes failed", report.failures.len()).into()) }
+            if report.failures.is_empty() {
+                Ok(())
+            } else {
+                Err(format!("{} episodes failed", report.failures.len()).into())
+            }
         }
     }
 }

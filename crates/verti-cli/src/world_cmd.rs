@@ -264,7 +264,12 @@ fn show(a: ShowArgs) -> CmdResult {
 
 fn render(a: RenderArgs) -> CmdResult {
     let w = resolve_world(&a.world, a.scale.scale)?;
-    let options = verti_render::RenderOptions { pixels_per_cell: a.px_per_cell, pairs: a.pairs, show_grid: a.grid, ..Default::default() };
+    let options = verti_render::RenderOptions {
+        pixels_per_cell: a.px_per_cell,
+        pairs: a.pairs,
+        show_grid: a.grid,
+        ..Default::default()
+    };
     ensure_parent(&a.out)?;
     verti_render::render_world_png(&w, &options, &a.out)?;
     println!("rendered {} to {}", w.meta.name, a.out.display());
@@ -293,7 +298,9 @@ fn stats(a: StatsArgs) -> CmdResult {
 /// Creates the parent folder of an output file.
 pub fn ensure_parent(path: &Path) -> Result<(), WorldError> {
     match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => std::fs::create_dir_all(p).map_err(|e| WorldError::io(p, e)),
+        Some(p) if !p.as_os_str().is_empty() => {
+            std::fs::create_dir_all(p).map_err(|e| WorldError::io(p, e))
+        }
         _ => Ok(()),
     }
 }

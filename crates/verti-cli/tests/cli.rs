@@ -16,7 +16,11 @@ fn tmp(name: &str) -> PathBuf {
 
 fn run_ok(args: &[&str]) -> String {
     let out = verti().args(args).output().unwrap();
-    assert!(out.status.success(), "verti {args:?} failed:\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "verti {args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     String::from_utf8(out.stdout).unwrap()
 }
 
@@ -39,13 +43,22 @@ fn lines(path: &PathBuf) -> Vec<serde_json::Value> {
 fn a_killed_evaluation_resumes_and_loses_nothing() {
     let out = tmp("kill");
     let out_s = out.to_str().unwrap();
-    let args = ["eval", "--system", "pid", "--worlds", "verti-4", "--jobs", "2", "--out", out_s];
-    let mut child = verti().args(args).stdout(Stdio::null()).stderr(Stdio::null()).spawn().unwrap();
+    let args = [
+        "eval", "--system", "pid", "--worlds", "verti-4", "--jobs", "2", "--out", out_s,
+    ];
+    let mut child = verti()
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
     // kill it once some results are on disk
     let results = out.join("results.jsonl");
     let t0 = Instant::now();
     loop {
-        let n = std::fs::read_to_string(&results).map(|t| t.lines().count()).unwrap_or(0);
+        let n = std::fs::read_to_string(&results)
+            .map(|t| t.lines().count())
+            .unwrap_or(0);
         if n >= 3 || t0.elapsed() > Duration::from_secs(120) {
             break;
         }
@@ -57,7 +70,10 @@ fn a_killed_evaluation_resumes_and_loses_nothing() {
     let _ = child.kill();
     let _ = child.wait();
     let partial = lines(&results).len();
-    assert!(partial < 40, "the run finished before it could be killed ({partial} results)");
+    assert!(
+        partial < 40,
+        "the run finished before it could be killed ({partial} results)"
+    );
 
     // without --resume it refuses; with it, it completes the set
     let e = run_err(&args);
@@ -68,11 +84,25 @@ fn a_killed_evaluation_resumes_and_loses_nothing() {
     let done = lines(&results);
     let mut tasks: Vec<u64> = done.iter().map(|r| r["task"].as_u64().unwrap()).collect();
     tasks.sort();
-    assert_eq!(tasks, (1..=40).collect::<Vec<_>>(), "every task exactly once after resuming");
+    assert_eq!(
+        tasks,
+        (1..=40).collect::<Vec<_>>(),
+        "every task exactly once after resuming"
+    );
 
     // and the results equal those of an uninterrupted run (but for wall time)
     let clean = tmp("clean");
-    run_ok(&["eval", "--system", "pid", "--worlds", "verti-4", "--jobs", "1", "--out", clean.to_str().unwrap()]);
+    run_ok(&[
+        "eval",
+        "--system",
+        "pid",
+        "--worlds",
+        "verti-4",
+        "--jobs",
+        "1",
+        "--out",
+        clean.to_str().unwrap(),
+    ]);
     let strip = |mut v: Vec<serde_json::Value>| {
         v.sort_by_key(|r| r["task"].as_u64());
         for r in &mut v {
@@ -86,42 +116,109 @@ fn a_killed_evaluation_resumes_and_loses_nothing() {
 #[test]
 fn bad_input_gets_clear_errors() {
     let e = run_err(&["eval", "--system", "teleport", "--worlds", "verti-1"]);
-    assert!(e.contains("unknown system `teleport`") && e.contains("pid"), "{e}");
-    let e = run_err(&["eval", "--system", "pid", "--tasks", "9-3", "--worlds", "verti-1"]);
+    assert!(
+        e.contains("unknown system `teleport`") && e.contains("pid"),
+        "{e}"
+    );
+    let e = run_err(&[
+        "eval", "--system", "pid", "--tasks", "9-3", "--worlds", "verti-1",
+    ]);
     assert!(e.contains("bad task range"), "{e}");
-    let e = run_err(&["eval", "--system", "pid", "--tasks", "11-20", "--worlds", "verti-1", "--out", tmp("range").to_str().unwrap()]);
+    let e = run_err(&[
+        "eval",
+        "--system",
+        "pid",
+        "--tasks",
+        "11-20",
+        "--worlds",
+        "verti-1",
+        "--out",
+        tmp("range").to_str().unwrap(),
+    ]);
     assert!(e.contains("not in this world set"), "{e}");
-    let e = run_err(&["eval", "--system", "pid", "--vehicle", "hovercraft", "--worlds", "verti-1"]);
+    let e = run_err(&[
+        "eval",
+        "--system",
+        "pid",
+        "--vehicle",
+        "hovercraft",
+        "--worlds",
+        "verti-1",
+    ]);
     assert!(e.contains("hovercraft") && e.contains("hmmwv"), "{e}");
     let e = run_err(&["eval", "--param", "speed=fast"]);
     assert!(e.contains("speed=fast"), "{e}");
-    let e = run_err(&["world", "generate", "--scale", "0", "--out", tmp("scale").to_str().unwrap()]);
+    let e = run_err(&[
+        "world",
+        "generate",
+        "--scale",
+        "0",
+        "--out",
+        tmp("scale").to_str().unwrap(),
+    ]);
     assert!(e.contains("scale"), "{e}");
 
     // a corrupt world on disk: the error names the file and the field
     let dir = tmp("corrupt");
-    run_ok(&["world", "generate", "--count", "1", "--out", dir.to_str().unwrap()]);
+    run_ok(&[
+        "world",
+        "generate",
+        "--count",
+        "1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
     let manifest = dir.join("world-001/world.yaml");
     let text = std::fs::read_to_string(&manifest).unwrap();
     std::fs::write(&manifest, text.replace("level: ", "level: extreme-")).unwrap();
-    let e = run_err(&["eval", "--worlds", dir.to_str().unwrap(), "--out", tmp("corrupt-out").to_str().unwrap()]);
+    let e = run_err(&[
+        "eval",
+        "--worlds",
+        dir.to_str().unwrap(),
+        "--out",
+        tmp("corrupt-out").to_str().unwrap(),
+    ]);
     assert!(e.contains("world.yaml") && e.contains("extreme-"), "{e}");
 }
 
 #[test]
 fn world_commands_work_end_to_end() {
     let dir = tmp("worlds");
-    let out = run_ok(&["world", "generate", "--count", "3", "--seed", "5", "--out", dir.to_str().unwrap()]);
+    let out = run_ok(&[
+        "world",
+        "generate",
+        "--count",
+        "3",
+        "--seed",
+        "5",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
     assert!(out.contains("3 worlds, 30 tasks"), "{out}");
     let show = run_ok(&["world", "show", dir.join("world-002").to_str().unwrap()]);
     assert!(show.contains("pair 9"), "{show}");
     let png = dir.join("w.png");
-    run_ok(&["world", "render", "verti-3-s5:2", "--out", png.to_str().unwrap()]);
+    run_ok(&[
+        "world",
+        "render",
+        "verti-3-s5:2",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
     assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
     let json = run_ok(&["world", "stats", dir.to_str().unwrap(), "--json"]);
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(v["worlds"], 3);
-    let e = run_err(&["world", "generate", "--count", "3", "--seed", "5", "--out", dir.to_str().unwrap()]);
+    let e = run_err(&[
+        "world",
+        "generate",
+        "--count",
+        "3",
+        "--seed",
+        "5",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
     assert!(e.contains("not empty") && e.contains("--force"), "{e}");
     let listed = run_ok(&["vehicle", "list"]);
     assert!(listed.contains("hmmwv") && listed.contains("m113"));

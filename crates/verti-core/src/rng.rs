@@ -188,7 +188,9 @@ mod tests {
             sab += a * b;
         }
         let nf = n as f64;
-        assert!((sa / nf - 1.0).abs() < 0.01 && (sb / nf - 1.0).abs() < 0.01 && (sab / nf).abs() < 0.01);
+        assert!(
+            (sa / nf - 1.0).abs() < 0.01 && (sb / nf - 1.0).abs() < 0.01 && (sab / nf).abs() < 0.01
+        );
         assert!((u - 0.5).abs() < 0.005);
     }
 

@@ -10,11 +10,11 @@
 
 use parquet::basic::Compression;
 use parquet::data_type::{DoubleType, Int32Type};
+use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
 use parquet::file::reader::{FileReader, SerializedFileReader};
-use parquet::record::RowAccessor;
 use parquet::file::writer::SerializedFileWriter;
-use parquet::file::metadata::KeyValue;
+use parquet::record::RowAccessor;
 use parquet::schema::parser::parse_message_type;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -26,15 +26,23 @@ pub enum LogError {
     #[error("{path}: {message}")]
     Parquet { path: PathBuf, message: String },
     #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
 }
 
 /// The DOUBLE columns, in file order.
-pub const COLUMNS: [&str; 16] =
-    ["t", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz", "wx", "wy", "wz", "throttle", "brake", "steering"];
+pub const COLUMNS: [&str; 16] = [
+    "t", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz", "wx", "wy", "wz", "throttle",
+    "brake", "steering",
+];
 
 fn value(s: &StepRecord, column: usize) -> f64 {
-    [s.t, s.x, s.y, s.z, s.roll, s.pitch, s.yaw, s.vx, s.vy, s.vz, s.wx, s.wy, s.wz, s.throttle, s.brake, s.steering][column]
+    [
+        s.t, s.x, s.y, s.z, s.roll, s.pitch, s.yaw, s.vx, s.vy, s.vz, s.wx, s.wy, s.wz, s.throttle,
+        s.brake, s.steering,
+    ][column]
 }
 
 fn schema() -> String {
@@ -52,8 +60,15 @@ pub fn log_file_name(task: u32) -> String {
 }
 
 /// Writes one trial's steps (snappy-compressed, one row group).
-pub fn write_steps(path: &Path, result: &TrialResult, steps: &[StepRecord]) -> Result<(), LogError> {
-    let err = |e: parquet::errors::ParquetError| LogError::Parquet { path: path.to_path_buf(), message: e.to_string() };
+pub fn write_steps(
+    path: &Path,
+    result: &TrialResult,
+    steps: &[StepRecord],
+) -> Result<(), LogError> {
+    let err = |e: parquet::errors::ParquetError| LogError::Parquet {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
     let schema = Arc::new(parse_message_type(&schema()).map_err(err)?);
     let meta = [
         ("verti.task", result.task.to_string()),
@@ -64,34 +79,54 @@ pub fn write_steps(path: &Path, result: &TrialResult, steps: &[StepRecord]) -> R
     ];
     let props = WriterProperties::builder()
         .set_compression(Compression::SNAPPY)
-        .set_key_value_metadata(Some(meta.iter().map(|(k, v)| KeyValue::new(k.to_string(), v.clone())).collect()))
+        .set_key_value_metadata(Some(
+            meta.iter()
+                .map(|(k, v)| KeyValue::new(k.to_string(), v.clone()))
+                .collect(),
+        ))
         .build();
     // write to a temporary name and rename, so a kill never leaves a half-written log
     let tmp = path.with_extension("parquet.partial");
-    let file = std::fs::File::create(&tmp).map_err(|e| LogError::Io { path: tmp.clone(), source: e })?;
+    let file = std::fs::File::create(&tmp).map_err(|e| LogError::Io {
+        path: tmp.clone(),
+        source: e,
+    })?;
     let mut writer = SerializedFileWriter::new(file, schema, Arc::new(props)).map_err(err)?;
     let mut rg = writer.next_row_group().map_err(err)?;
     let tasks = vec![result.task as i32; steps.len()];
     let mut column = 0usize;
     while let Some(mut col) = rg.next_column().map_err(err)? {
         if column == 0 {
-            col.typed::<Int32Type>().write_batch(&tasks, None, None).map_err(err)?;
+            col.typed::<Int32Type>()
+                .write_batch(&tasks, None, None)
+                .map_err(err)?;
         } else {
             let values: Vec<f64> = steps.iter().map(|s| value(s, column - 1)).collect();
-            col.typed::<DoubleType>().write_batch(&values, None, None).map_err(err)?;
+            col.typed::<DoubleType>()
+                .write_batch(&values, None, None)
+                .map_err(err)?;
         }
         col.close().map_err(err)?;
         column += 1;
     }
     rg.close().map_err(err)?;
     writer.close().map_err(err)?;
-    std::fs::rename(&tmp, path).map_err(|e| LogError::Io { path: path.to_path_buf(), source: e })
+    std::fs::rename(&tmp, path).map_err(|e| LogError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })
 }
 
 /// Reads a log back (for tests and tools).
 pub fn read_steps(path: &Path) -> Result<(u32, Vec<StepRecord>), LogError> {
-    let err = |e: parquet::errors::ParquetError| LogError::Parquet { path: path.to_path_buf(), message: e.to_string() };
-    let file = std::fs::File::open(path).map_err(|e| LogError::Io { path: path.to_path_buf(), source: e })?;
+    let err = |e: parquet::errors::ParquetError| LogError::Parquet {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let file = std::fs::File::open(path).map_err(|e| LogError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
     let reader = SerializedFileReader::new(file).map_err(err)?;
     let mut task = 0u32;
     let mut out = Vec::new();

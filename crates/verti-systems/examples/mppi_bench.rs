@@ -11,13 +11,23 @@ use verti_systems::mppi::{Mppi, MppiParams};
 use verti_world::generate::{SetConfig, generate_set};
 
 fn main() {
-    let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .filter_map(|a| a.parse().ok())
+        .collect();
     let params = MppiParams {
         samples: args.first().copied().unwrap_or(1024),
         horizon: args.get(1).copied().unwrap_or(50),
         ..Default::default()
     };
-    let worlds = generate_set(&SetConfig { count: 5, ..Default::default() }, &|| {}).unwrap();
+    let worlds = generate_set(
+        &SetConfig {
+            count: 5,
+            ..Default::default()
+        },
+        &|| {},
+    )
+    .unwrap();
     let spec = verti_sim::vehicles::builtin("hmmwv").unwrap();
     let mut times = Vec::new();
     for w in worlds.into_iter().map(Arc::new) {
@@ -25,7 +35,13 @@ fn main() {
             let info = task_info(&w, &spec, pair, 0).unwrap();
             let mut m = Mppi::new(params.clone());
             m.reset(&info);
-            let obs = test_observation(&w, info.start, (info.goal[1] - info.start[1]).atan2(info.goal[0] - info.start[0]), info.goal, &info.global_path);
+            let obs = test_observation(
+                &w,
+                info.start,
+                (info.goal[1] - info.start[1]).atan2(info.goal[0] - info.start[0]),
+                info.goal,
+                &info.global_path,
+            );
             for _ in 0..20 {
                 let t0 = std::time::Instant::now();
                 std::hint::black_box(m.plan_once(&obs));

@@ -21,7 +21,10 @@ pub struct EhParams {
 
 impl Default for EhParams {
     fn default() -> Self {
-        EhParams { pid: PidParams::default(), terrain_weight: 0.2 }
+        EhParams {
+            pid: PidParams::default(),
+            terrain_weight: 0.2,
+        }
     }
 }
 
@@ -38,21 +41,34 @@ const BAND: usize = 13;
 impl ElevationHeuristic {
     pub fn new(params: EhParams) -> Self {
         let pid = Pid::new(params.pid.clone());
-        ElevationHeuristic { params, pid, scale: 1.0 }
+        ElevationHeuristic {
+            params,
+            pid,
+            scale: 1.0,
+        }
     }
 
     /// Index (0 = leftmost) of the chosen region and its heading error.
     pub fn choose_region(&self, obs: &Observation) -> (usize, f64) {
-        let spec = CropSpec { size: CROP_CELLS, resolution: CROP_RES * self.scale };
+        let spec = CropSpec {
+            size: CROP_CELLS,
+            resolution: CROP_RES * self.scale,
+        };
         let crop = obs.elevation_crop(spec);
         let mean_var = |rows: std::ops::Range<usize>, cols: std::ops::Range<usize>| {
-            let vals: Vec<f64> = rows.flat_map(|r| cols.clone().map(move |c| (r, c))).map(|(r, c)| crop.get(r, c)).collect();
+            let vals: Vec<f64> = rows
+                .flat_map(|r| cols.clone().map(move |c| (r, c)))
+                .map(|(r, c)| crop.get(r, c))
+                .collect();
             let m = vals.iter().sum::<f64>() / vals.len() as f64;
             let v = vals.iter().map(|x| (x - m).powi(2)).sum::<f64>() / vals.len() as f64;
             (m, v)
         };
         let centre = CROP_CELLS / 2;
-        let (under, _) = mean_var(centre - BAND / 2..centre + BAND / 2 + 1, centre - BAND / 2..centre + BAND / 2 + 1);
+        let (under, _) = mean_var(
+            centre - BAND / 2..centre + BAND / 2 + 1,
+            centre - BAND / 2..centre + BAND / 2 + 1,
+        );
         let mut best = (f64::INFINITY, f64::INFINITY, 0usize);
         for k in 0..5 {
             let (m, v) = mean_var(0..2 * BAND, k * BAND..(k + 1) * BAND);
@@ -85,6 +101,9 @@ impl MobilitySystem for ElevationHeuristic {
         let (_, e_terrain) = self.choose_region(obs);
         let w = self.params.terrain_weight;
         let e = w * e_terrain + (1.0 - w) * e_path;
-        Action::HighLevel { speed: self.pid.target_speed(), steering: self.pid.steer(e) }
+        Action::HighLevel {
+            speed: self.pid.target_speed(),
+            steering: self.pid.steer(e),
+        }
     }
 }

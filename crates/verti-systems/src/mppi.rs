@@ -103,15 +103,26 @@ impl Mppi {
         let p = &self.params;
         let (k, h) = (p.samples.max(1), p.horizon.max(1));
         let v_nom = self.nominal_speed();
-        let local = self.follower.local_goal(obs.pose.x, obs.pose.y, p.lookahead * self.scale, self.goal);
-        let start = Pose2 { x: obs.pose.x, y: obs.pose.y, yaw: obs.pose.yaw };
-        let d0 = ((local[0] - start.x).powi(2) + (local[1] - start.y).powi(2)).sqrt().max(1e-3);
+        let local =
+            self.follower
+                .local_goal(obs.pose.x, obs.pose.y, p.lookahead * self.scale, self.goal);
+        let start = Pose2 {
+            x: obs.pose.x,
+            y: obs.pose.y,
+            yaw: obs.pose.yaw,
+        };
+        let d0 = ((local[0] - start.x).powi(2) + (local[1] - start.y).powi(2))
+            .sqrt()
+            .max(1e-3);
         // occupancy crop covering the reachable area: radius v·T plus margin
         let reach = v_nom * 1.5 * p.step * h as f64 + 2.0 * self.scale;
         // obstacles are at least 3 m across: 0.4 m cells resolve them and keep the crop cheap
         let res = 0.4 * self.scale;
         let size = ((2.0 * reach / res).ceil() as usize) | 1;
-        let spec = CropSpec { size, resolution: res };
+        let spec = CropSpec {
+            size,
+            resolution: res,
+        };
         let occ = obs.occupancy_crop(spec);
         let half = 0.5 * (size as f64 - 1.0);
         let (sy, cy) = start.yaw.sin_cos();
@@ -151,7 +162,8 @@ impl Mppi {
         };
         let inv_h = 1.0 / h as f64;
         let inv_d0 = 1.0 / d0;
-        let ctrl_scale = p.w_control * p.lambda / (p.sigma_steer * p.sigma_steer).max(1e-12) * inv_h;
+        let ctrl_scale =
+            p.w_control * p.lambda / (p.sigma_steer * p.sigma_steer).max(1e-12) * inv_h;
         let (c0, s0) = (start.yaw.cos(), start.yaw.sin());
         for s in 0..k {
             let (mut x, mut y) = (start.x, start.y);
@@ -171,7 +183,9 @@ impl Mppi {
                 x += v * c * p.step;
                 y += v * sn * p.step;
                 let dist = ((local[0] - x).powi(2) + (local[1] - y).powi(2)).sqrt() * inv_d0;
-                cost += p.w_goal * dist * inv_h + if occupied(x, y) { p.w_obstacle } else { 0.0 } + ctrl_scale * (pd * nd).abs();
+                cost += p.w_goal * dist * inv_h
+                    + if occupied(x, y) { p.w_obstacle } else { 0.0 }
+                    + ctrl_scale * (pd * nd).abs();
             }
             let dist = ((local[0] - x).powi(2) + (local[1] - y).powi(2)).sqrt() * inv_d0;
             self.costs[s] = cost + p.w_goal * dist;

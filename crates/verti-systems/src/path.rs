@@ -26,7 +26,8 @@ impl PathFollower {
         }
         let d2 = |p: &[f64; 2]| (p[0] - x).powi(2) + (p[1] - y).powi(2);
         // closest point within a forward window of 3 lookaheads of path points
-        let window_end = (self.progress + 1 + (3.0 * lookahead).ceil() as usize * 4).min(self.path.len());
+        let window_end =
+            (self.progress + 1 + (3.0 * lookahead).ceil() as usize * 4).min(self.path.len());
         let mut best = self.progress;
         for i in self.progress..window_end {
             if d2(&self.path[i]) < d2(&self.path[best]) {
@@ -64,6 +65,8 @@ mod tests {
         assert_eq!(f.local_goal(95.0, 0.0, 10.0, [0.0; 2]), [100.0, 0.0]);
         let mut empty = PathFollower::new(vec![]);
         assert_eq!(empty.local_goal(0.0, 0.0, 10.0, [7.0, 7.0]), [7.0, 7.0]);
-        assert!((heading_error(0.0, 0.0, 0.0, [0.0, 1.0]) - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert!(
+            (heading_error(0.0, 0.0, 0.0, [0.0, 1.0]) - std::f64::consts::FRAC_PI_2).abs() < 1e-12
+        );
     }
 }

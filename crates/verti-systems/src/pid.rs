@@ -21,7 +21,14 @@ pub struct PidParams {
 
 impl Default for PidParams {
     fn default() -> Self {
-        PidParams { speed: 3.0, lookahead: 10.0, kp: 1.0, ki: 0.0, kd: 0.0, rate: 20.0 }
+        PidParams {
+            speed: 3.0,
+            lookahead: 10.0,
+            kp: 1.0,
+            ki: 0.0,
+            kd: 0.0,
+            rate: 20.0,
+        }
     }
 }
 
@@ -37,12 +44,25 @@ pub struct Pid {
 
 impl Pid {
     pub fn new(params: PidParams) -> Self {
-        Pid { params, follower: PathFollower::default(), goal: [0.0; 2], scale: 1.0, max_steer: 0.5, integral: 0.0, last_error: None }
+        Pid {
+            params,
+            follower: PathFollower::default(),
+            goal: [0.0; 2],
+            scale: 1.0,
+            max_steer: 0.5,
+            integral: 0.0,
+            last_error: None,
+        }
     }
 
     /// Heading error toward the local goal (used by EH too).
     pub fn path_heading_error(&mut self, obs: &Observation) -> f64 {
-        let g = self.follower.local_goal(obs.pose.x, obs.pose.y, self.params.lookahead * self.scale, self.goal);
+        let g = self.follower.local_goal(
+            obs.pose.x,
+            obs.pose.y,
+            self.params.lookahead * self.scale,
+            self.goal,
+        );
         heading_error(obs.pose.x, obs.pose.y, obs.pose.yaw, g)
     }
 
@@ -52,7 +72,8 @@ impl Pid {
         self.integral = (self.integral + error * dt).clamp(-1.0, 1.0);
         let derivative = self.last_error.map_or(0.0, |l| (error - l) / dt);
         self.last_error = Some(error);
-        let angle = self.params.kp * error + self.params.ki * self.integral + self.params.kd * derivative;
+        let angle =
+            self.params.kp * error + self.params.ki * self.integral + self.params.kd * derivative;
         (angle / self.max_steer).clamp(-1.0, 1.0)
     }
 
@@ -78,6 +99,9 @@ impl MobilitySystem for Pid {
     }
     fn act(&mut self, obs: &Observation) -> Action {
         let e = self.path_heading_error(obs);
-        Action::HighLevel { speed: self.target_speed(), steering: self.steer(e) }
+        Action::HighLevel {
+            speed: self.target_speed(),
+            steering: self.steer(e),
+        }
     }
 }

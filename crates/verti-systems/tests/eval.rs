@@ -3,14 +3,24 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 use verti_bench::EpisodeConfig;
-use verti_bench::eval::{EvalSetup, RESULTS_FILE, RunInfo, evaluate, parse_tasks, read_results};
 use verti_bench::episode::{Outcome, Rules};
+use verti_bench::eval::{EvalSetup, RESULTS_FILE, RunInfo, evaluate, parse_tasks, read_results};
 use verti_sim::vehicles;
 use verti_world::World;
 use verti_world::generate::{SetConfig, generate_set};
 
 fn worlds(n: u32) -> Vec<Arc<World>> {
-    generate_set(&SetConfig { count: n, ..Default::default() }, &|| {}).unwrap().into_iter().map(Arc::new).collect()
+    generate_set(
+        &SetConfig {
+            count: n,
+            ..Default::default()
+        },
+        &|| {},
+    )
+    .unwrap()
+    .into_iter()
+    .map(Arc::new)
+    .collect()
 }
 
 fn tmp(name: &str) -> PathBuf {
@@ -19,11 +29,20 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-fn setup<'a>(worlds: &'a [Arc<World>], vehicle: &'a verti_sim::VehicleSpec, out: PathBuf, jobs: usize, system: &str) -> EvalSetup<'a> {
+fn setup<'a>(
+    worlds: &'a [Arc<World>],
+    vehicle: &'a verti_sim::VehicleSpec,
+    out: PathBuf,
+    jobs: usize,
+    system: &str,
+) -> EvalSetup<'a> {
     EvalSetup {
         worlds,
         vehicle,
-        episode: EpisodeConfig { max_time: 30.0, ..Default::default() },
+        episode: EpisodeConfig {
+            max_time: 30.0,
+            ..Default::default()
+        },
         jobs,
         out,
         resume: false,
@@ -64,11 +83,31 @@ fn results_are_identical_for_any_number_of_jobs() {
     let hmmwv = vehicles::builtin("hmmwv").unwrap();
     for system in ["pid", "mppi"] {
         // MPPI draws random samples: its per-task seed makes it deterministic too
-        let params: Vec<(String, f64)> = if system == "mppi" { vec![("samples".into(), 64.0), ("horizon".into(), 20.0)] } else { vec![] };
+        let params: Vec<(String, f64)> = if system == "mppi" {
+            vec![("samples".into(), 64.0), ("horizon".into(), 20.0)]
+        } else {
+            vec![]
+        };
         let make = || verti_systems::create(system, &params).unwrap();
-        let tasks = if system == "mppi" { parse_tasks("1-3").unwrap() } else { Vec::new() };
-        let a = evaluate(&setup(&ws, &hmmwv, tmp(&format!("{system}-j1")), 1, system), &tasks, &make, &|_| {}).unwrap();
-        let b = evaluate(&setup(&ws, &hmmwv, tmp(&format!("{system}-j2")), 2, system), &tasks, &make, &|_| {}).unwrap();
+        let tasks = if system == "mppi" {
+            parse_tasks("1-3").unwrap()
+        } else {
+            Vec::new()
+        };
+        let a = evaluate(
+            &setup(&ws, &hmmwv, tmp(&format!("{system}-j1")), 1, system),
+            &tasks,
+            &make,
+            &|_| {},
+        )
+        .unwrap();
+        let b = evaluate(
+            &setup(&ws, &hmmwv, tmp(&format!("{system}-j2")), 2, system),
+            &tasks,
+            &make,
+            &|_| {},
+        )
+        .unwrap();
         assert_eq!(a.len(), if system == "mppi" { 3 } else { 20 });
         assert!(a.iter().all(|r| r.outcome != Outcome::Error), "{a:?}");
         assert_same(a, b, &format!("{system} with 1 and 2 jobs"));
@@ -80,11 +119,23 @@ fn a_torn_results_file_resumes_without_losing_or_repeating_trials() {
     let ws = worlds(2);
     let hmmwv = vehicles::builtin("hmmwv").unwrap();
     let make = || verti_systems::create("pid", &[]).unwrap();
-    let full = evaluate(&setup(&ws, &hmmwv, tmp("full"), 2, "pid"), &[], &make, &|_| {}).unwrap();
+    let full = evaluate(
+        &setup(&ws, &hmmwv, tmp("full"), 2, "pid"),
+        &[],
+        &make,
+        &|_| {},
+    )
+    .unwrap();
 
     // a run killed after 7 trials, in the middle of writing the 8th line
     let out = tmp("torn");
-    let first = evaluate(&setup(&ws, &hmmwv, out.clone(), 2, "pid"), &parse_tasks("1-7").unwrap(), &make, &|_| {}).unwrap();
+    let first = evaluate(
+        &setup(&ws, &hmmwv, out.clone(), 2, "pid"),
+        &parse_tasks("1-7").unwrap(),
+        &make,
+        &|_| {},
+    )
+    .unwrap();
     assert_eq!(first.len(), 7);
     let path = out.join(RESULTS_FILE);
     let mut text = std::fs::read_to_string(&path).unwrap();
@@ -106,12 +157,20 @@ fn a_torn_results_file_resumes_without_losing_or_repeating_trials() {
     assert!(e.contains("different settings"), "{e}");
     s.run.seed = 0;
     let resumed = evaluate(&s, &[], &make, &|_| {}).unwrap();
-    assert_same(resumed, full.clone(), "resumed run against an uninterrupted one");
+    assert_same(
+        resumed,
+        full.clone(),
+        "resumed run against an uninterrupted one",
+    );
     let (on_disk, clean) = read_results(&path).unwrap();
     assert!(clean);
     let mut tasks: Vec<u32> = on_disk.iter().map(|r| r.task).collect();
     tasks.sort();
-    assert_eq!(tasks, (1..=20).collect::<Vec<_>>(), "each task exactly once");
+    assert_eq!(
+        tasks,
+        (1..=20).collect::<Vec<_>>(),
+        "each task exactly once"
+    );
 }
 
 #[test]
@@ -122,8 +181,13 @@ fn bad_task_selections_are_rejected() {
     }
     assert_eq!(parse_tasks("3,1-2, 10").unwrap(), vec![1, 2, 3, 10]);
     let ws = worlds(2);
-    let e = verti_bench::eval::select_tasks(&ws, &parse_tasks("15-25").unwrap()).unwrap_err().to_string();
-    assert!(e.contains("not in this world set") && e.contains("1..=20"), "{e}");
+    let e = verti_bench::eval::select_tasks(&ws, &parse_tasks("15-25").unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("not in this world set") && e.contains("1..=20"),
+        "{e}"
+    );
 }
 
 #[test]

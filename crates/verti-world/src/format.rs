@@ -294,7 +294,11 @@ pub fn load_world(path: &Path) -> Result<World> {
         ));
     }
     if m.index == 0 {
-        return Err(WorldError::invalid(&mpath, "index", "world indices start at 1"));
+        return Err(WorldError::invalid(
+            &mpath,
+            "index",
+            "world indices start at 1",
+        ));
     }
     crate::scale::check_scale(m.scale)
         .map_err(|e| WorldError::invalid(&mpath, "scale", e.to_string()))?;
