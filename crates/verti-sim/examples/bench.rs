@@ -20,7 +20,14 @@ fn main() {
         BenchWorlds::generated_for(&specs).expect("generated worlds")
     };
     for p in &worlds.pairs {
-        eprintln!("scale {}: rigid {} ({} obstacles, relief {:.1} m), soil {}", p.scale, p.rigid.meta.name, p.rigid.obstacles.len(), p.rigid.terrain.max_height() - p.rigid.terrain.min_height(), p.soil.meta.name);
+        eprintln!(
+            "scale {}: rigid {} ({} obstacles, relief {:.1} m), soil {}",
+            p.scale,
+            p.rigid.meta.name,
+            p.rigid.obstacles.len(),
+            p.rigid.terrain.max_height() - p.rigid.terrain.min_height(),
+            p.soil.meta.name
+        );
     }
     let report = bench(&worlds, &specs, seconds, runs);
     print!("{report}");

@@ -4,7 +4,11 @@ use verti_sim::{BenchWorlds, Sim, bench::bench_controls, start_pose, vehicles};
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let spec = vehicles::builtin(args.get(1).map_or("hmmwv", |s| s.as_str())).unwrap();
-    let worlds = if std::env::var("SYNTHETIC").is_ok() { BenchWorlds::synthetic(&[spec.scale]) } else { BenchWorlds::generated(&[spec.scale]).unwrap() };
+    let worlds = if std::env::var("SYNTHETIC").is_ok() {
+        BenchWorlds::synthetic(&[spec.scale])
+    } else {
+        BenchWorlds::generated(&[spec.scale]).unwrap()
+    };
     let pair = &worlds.pairs[0];
     let world = if args.get(2).map(|s| s.as_str()) == Some("soil") {
         &pair.soil
@@ -30,7 +34,12 @@ fn main() {
             let w: Vec<String> = st
                 .wheels()
                 .iter()
-                .map(|w| format!("{:.0}/{:.0}/{:.0}/{:.2}/{:.3}", w.normal_force, w.long_force, w.lat_force, w.spin_rate, w.slip_long))
+                .map(|w| {
+                    format!(
+                        "{:.0}/{:.0}/{:.0}/{:.2}/{:.3}",
+                        w.normal_force, w.long_force, w.lat_force, w.spin_rate, w.slip_long
+                    )
+                })
                 .collect();
             println!(
                 "t {:5.1} p ({:7.2} {:7.2} {:6.2}) rpy ({:6.1} {:6.1} {:6.1}) v {:6.2} |v| {:6.2} c {:.2}/{:.2} cont {:?} w {}",

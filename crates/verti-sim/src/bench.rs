@@ -55,30 +55,49 @@ impl BenchWorlds {
     /// world that is high-elevation, rigid and dense, and the first deformable world of the
     /// highest elevation level available. Errors when the generator fails.
     pub fn generated(scales: &[f64]) -> Result<BenchWorlds, String> {
-        use verti_world::generate::{SetConfig, composition, elevation::ProceduralRock, generate_world};
+        use verti_world::generate::{
+            SetConfig, composition, elevation::ProceduralRock, generate_world,
+        };
         use verti_world::{ElevationLevel, ObstacleDensity, TerrainType};
         let mut pairs: Vec<BenchWorldPair> = Vec::new();
         for &scale in scales {
             if pairs.iter().any(|p| (p.scale - scale).abs() < 1e-9) {
                 continue;
             }
-            let config = SetConfig { scale, ..Default::default() };
+            let config = SetConfig {
+                scale,
+                ..Default::default()
+            };
             let comp = composition(&config);
             let pick = |want: &dyn Fn(&(ElevationLevel, TerrainType, ObstacleDensity)) -> bool| {
                 comp.iter().position(want).map(|i| i as u32 + 1)
             };
-            let rigid = pick(&|c| c.0 == ElevationLevel::High && c.1 == TerrainType::Rigid && c.2 == ObstacleDensity::Dense)
-                .or_else(|| pick(&|c| c.1 == TerrainType::Rigid))
-                .ok_or("the set has no rigid world")?;
-            let soil = [ElevationLevel::High, ElevationLevel::Mid, ElevationLevel::Low]
-                .iter()
-                .find_map(|l| pick(&|c| c.0 == *l && c.1 == TerrainType::Deformable))
-                .ok_or("the set has no deformable world")?;
+            let rigid = pick(&|c| {
+                c.0 == ElevationLevel::High
+                    && c.1 == TerrainType::Rigid
+                    && c.2 == ObstacleDensity::Dense
+            })
+            .or_else(|| pick(&|c| c.1 == TerrainType::Rigid))
+            .ok_or("the set has no rigid world")?;
+            let soil = [
+                ElevationLevel::High,
+                ElevationLevel::Mid,
+                ElevationLevel::Low,
+            ]
+            .iter()
+            .find_map(|l| pick(&|c| c.0 == *l && c.1 == TerrainType::Deformable))
+            .ok_or("the set has no deformable world")?;
             let make = |index: u32| {
                 let (l, t, d) = comp[index as usize - 1];
-                generate_world(&config, index, l, t, d, &ProceduralRock::default()).map(Arc::new).map_err(|e| e.to_string())
+                generate_world(&config, index, l, t, d, &ProceduralRock::default())
+                    .map(Arc::new)
+                    .map_err(|e| e.to_string())
             };
-            pairs.push(BenchWorldPair { scale, rigid: make(rigid)?, soil: make(soil)? });
+            pairs.push(BenchWorldPair {
+                scale,
+                rigid: make(rigid)?,
+                soil: make(soil)?,
+            });
         }
         Ok(BenchWorlds { pairs })
     }

@@ -41,6 +41,8 @@ pub const SOIL_DELTA_FULL_SCALE: f64 = 0.1;
 const POSITION_LIMIT: f64 = 1.0e5;
 /// Any speed above this (m/s at full scale) is a blow-up.
 const SPEED_LIMIT: f64 = 500.0;
+/// Body-contact stiffness against obstacles relative to terrain (damping scales with √).
+const OBSTACLE_STIFFENING: f64 = 4.0;
 /// Safety cap on soil nodes visited per wheel per step.
 const MAX_SOIL_NODES_PER_WHEEL: usize = 4096;
 
@@ -720,7 +722,11 @@ impl Sim {
             }
         }
         // Body contact stiffness: chassis contact mode at ω·h = 0.15 when a quarter of the mass
-        // rests on one point; damping ratio 0.5.
+        // rests on one point; damping ratio 0.5. Against obstacles it is 4x stiffer
+        // (ω·h = 0.3): those contacts are few points hit at speed, where a soft contact
+        // would let a thin trunk sink half a metre into the body; against terrain many
+        // points rest at once (a rolled vehicle on its roof) and the softer value keeps that
+        // stable.
         let omega_body = 0.15 / h;
         let body_stiffness = 0.25 * total_mass * omega_body * omega_body;
         let body_damping = 2.0 * 0.5 * (body_stiffness * 0.25 * total_mass).sqrt();
@@ -1473,7 +1479,7 @@ impl Sim {
                 hub + (down * 0.3624 - fwd * 0.9320) * r,
             ];
             for (k, p) in samples.iter().enumerate() {
-                if k > 0 && p.z >= self.bound.max_at(p.x, p.y) {
+                if k > 0 && (p.z >= ground_max || p.z >= self.bound.max_at(p.x, p.y)) {
                     continue;
                 }
                 let (h, gx, gy) = ground.sample(p.x, p.y);
@@ -1757,11 +1763,12 @@ impl Sim {
             x1 = x1.max(w.x);
             y1 = y1.max(w.y);
         }
-        let mut apply = |point: Vec3, n: Vec3, depth: f64, mu: f64| {
+        // `stiff` = 1 for terrain, 4 for obstacles: see `Sim::new`
+        let mut apply = |point: Vec3, n: Vec3, depth: f64, mu: f64, stiff: f64| {
             let arm = point - st.position;
             let v = st.velocity + omega_w.cross(arm);
             let vn = v.dot(n);
-            let fnorm = self.body_stiffness * depth - self.body_damping * vn;
+            let fnorm = stiff * self.body_stiffness * depth - stiff.sqrt() * self.body_damping * vn;
             if fnorm <= 0.0 {
                 return false;
             }
@@ -1777,10 +1784,12 @@ impl Sim {
             *torque += arm.cross(f);
             true
         };
-        if z0 < self.bound.max_in(x0, y0, x1, y1) {
+        let box_bound = self.bound.max_in(x0, y0, x1, y1);
+        if z0 < box_bound {
             let patches = world.patches.patches();
             for p in &pts {
-                if p.z >= self.bound.max_at(p.x, p.y) {
+                // cheap compare against the whole box's bound first, then the point's own block
+                if p.z >= box_bound || p.z >= self.bound.max_at(p.x, p.y) {
                     continue;
                 }
                 let (h, gx, gy) = self.ground.sample(p.x, p.y);
@@ -1795,7 +1804,7 @@ impl Sim {
                         soil.friction_angle_deg.to_radians().tan().min(mu_body)
                     }
                 };
-                if apply(*p, n, (h - p.z) * nz, mu) {
+                if apply(*p, n, (h - p.z) * nz, mu, 1.0) {
                     contacts.chassis_terrain_points += 1;
                 }
             }
@@ -1820,10 +1829,40 @@ impl Sim {
             if fo.separated_from_box(box_world, &rm, self.box_half) {
                 continue;
             }
+            if let Some((cx, cy, radius, tz0, tz1)) = fo.tree {
+                // A trunk is thinner than a body contact's penetration at speed, and a point
+                // that passes its axis would be pulled through. Test the trunk's axis (at the
+                // box's height) against the box grown by the radius instead: the box face it is
+                // nearest to gives a normal that cannot flip.
+                let axis_point = Vec3::new(cx, cy, box_world.z.clamp(tz0, tz1));
+                let local = q.inverse_rotate(axis_point - box_world);
+                let d = Vec3::new(
+                    self.box_half.x + radius - local.x.abs(),
+                    self.box_half.y + radius - local.y.abs(),
+                    self.box_half.z - local.z.abs(),
+                );
+                if d.x > 0.0 && d.y > 0.0 && d.z > 0.0 {
+                    let v_local =
+                        -q.inverse_rotate(st.velocity + omega_w.cross(axis_point - st.position));
+                    let (depth, n_local) = box_penetration(local, v_local, d);
+                    let n = q.rotate(n_local);
+                    // contact on the trunk's surface facing the box
+                    if apply(
+                        axis_point + n * radius,
+                        n,
+                        depth,
+                        mu_obs,
+                        OBSTACLE_STIFFENING,
+                    ) {
+                        contacts.chassis_obstacle_points += 1;
+                    }
+                }
+                continue;
+            }
             // chassis points inside the obstacle
             for p in &pts {
                 let (d, n) = fo.signed_distance(*p);
-                if d < 0.0 && apply(*p, n, -d, mu_obs) {
+                if d < 0.0 && apply(*p, n, -d, mu_obs, OBSTACLE_STIFFENING) {
                     contacts.chassis_obstacle_points += 1;
                 }
             }
@@ -1838,19 +1877,66 @@ impl Sim {
                 if d.x <= 0.0 || d.y <= 0.0 || d.z <= 0.0 {
                     continue;
                 }
-                let (depth, n_local) = if d.x <= d.y && d.x <= d.z {
-                    (d.x, Vec3::new(-local.x.signum(), 0.0, 0.0))
-                } else if d.y <= d.z {
-                    (d.y, Vec3::new(0.0, -local.y.signum(), 0.0))
-                } else {
-                    (d.z, Vec3::new(0.0, 0.0, -local.z.signum()))
-                };
-                if apply(*v, q.rotate(n_local), depth, mu_obs) {
+                let v_local = -q.inverse_rotate(st.velocity + omega_w.cross(*v - st.position));
+                let (depth, n_local) = box_penetration(local, v_local, d);
+                if apply(*v, q.rotate(n_local), depth, mu_obs, OBSTACLE_STIFFENING) {
                     contacts.chassis_obstacle_points += 1;
                 }
             }
         }
     }
+}
+
+/// Penetration of a point into a box, given its box-frame position `local`, its velocity
+/// relative to the box `v_local` and its depths `d` below the three face pairs (all positive).
+/// Returns the depth and the box-frame outward normal of the face it entered through: the face
+/// crossed most recently, i.e. the smallest depth / inward speed. The smallest depth alone
+/// would switch to a side face once a thin obstacle is pushed deep into a long box, and let
+/// the body slide past a tree it hit head-on.
+#[inline]
+fn box_penetration(local: Vec3, v_local: Vec3, d: Vec3) -> (f64, Vec3) {
+    let axes = [
+        (
+            d.x,
+            local.x,
+            v_local.x,
+            Vec3::new(-local.x.signum(), 0.0, 0.0),
+        ),
+        (
+            d.y,
+            local.y,
+            v_local.y,
+            Vec3::new(0.0, -local.y.signum(), 0.0),
+        ),
+        (
+            d.z,
+            local.z,
+            v_local.z,
+            Vec3::new(0.0, 0.0, -local.z.signum()),
+        ),
+    ];
+    let mut best = (f64::INFINITY, f64::INFINITY, Vec3::Z);
+    for (depth, pos, vel, n) in axes {
+        // inward speed: moving toward the box centre along this axis
+        let inward = -vel * pos.signum();
+        let key = if inward > 1e-3 {
+            depth / inward
+        } else {
+            f64::INFINITY
+        };
+        if key < best.0 || (key == best.0 && depth < best.1) {
+            best = (key, depth, n);
+        }
+    }
+    if best.0.is_infinite() {
+        // resting contact: the shallowest face
+        let (depth, _, _, n) = axes
+            .into_iter()
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .unwrap_or(axes[2]);
+        return (depth, n);
+    }
+    (best.1, best.2)
 }
 
 /// x / sqrt(1 + x²): a smooth sign without a transcendental call.

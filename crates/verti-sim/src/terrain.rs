@@ -296,7 +296,12 @@ impl FastObstacle {
     /// is certainly disjoint from the obstacle: it lies entirely outside one face plane of a
     /// rock, or outside a tree's bounding cylinder.
     #[inline]
-    pub fn separated_from_box(&self, center: verti_core::Vec3, rot: &verti_core::Mat3, half: verti_core::Vec3) -> bool {
+    pub fn separated_from_box(
+        &self,
+        center: verti_core::Vec3,
+        rot: &verti_core::Mat3,
+        half: verti_core::Vec3,
+    ) -> bool {
         let (ax, ay, az) = (rot.col(0), rot.col(1), rot.col(2));
         if let Some((cx, cy, radius, z0, z1)) = self.tree {
             // horizontal and vertical extents of the box
@@ -305,10 +310,13 @@ impl FastObstacle {
             let ez = half.x * ax.z.abs() + half.y * ay.z.abs() + half.z * az.z.abs();
             let r = ex.max(ey) * std::f64::consts::SQRT_2;
             let (dx, dy) = (center.x - cx, center.y - cy);
-            return dx * dx + dy * dy > (radius + r).powi(2) || center.z - ez > z1 || center.z + ez < z0;
+            return dx * dx + dy * dy > (radius + r).powi(2)
+                || center.z - ez > z1
+                || center.z + ez < z0;
         }
         self.faces.iter().any(|&(n, d)| {
-            let support = half.x * n.dot(ax).abs() + half.y * n.dot(ay).abs() + half.z * n.dot(az).abs();
+            let support =
+                half.x * n.dot(ax).abs() + half.y * n.dot(ay).abs() + half.z * n.dot(az).abs();
             n.dot(center) - d > support
         })
     }

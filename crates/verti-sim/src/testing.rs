@@ -163,6 +163,20 @@ pub fn rock_world(scale: f64, friction: f64, front_x: f64, size: Vec3) -> World 
     )
 }
 
+/// Flat ground with one tree (vertical cylinder of the given radius and height, world units)
+/// centred at (x, 0).
+pub fn tree_world(scale: f64, friction: f64, x: f64, radius: f64, height: f64) -> World {
+    let tree =
+        Obstacle::tree(radius, height, Vec3::new(x, 0.0, 0.5 * height)).expect("a valid tree");
+    world_from_fn(
+        "tree",
+        scale,
+        |_, _| 0.0,
+        uniform(rigid_patch(friction)),
+        vec![tree],
+    )
+}
+
 /// Terrain kinds for [`rough_world`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RoughSurface {

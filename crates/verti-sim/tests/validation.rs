@@ -56,7 +56,10 @@ fn static_sag_and_heave_frequency() {
         };
         let expected = load / k;
         let err = (wheel.compression - expected).abs() / expected;
-        println!("sag wheel {w}: {:.5} m vs m·g/k {expected:.5} m", wheel.compression);
+        println!(
+            "sag wheel {w}: {:.5} m vs m·g/k {expected:.5} m",
+            wheel.compression
+        );
         assert!(
             err < 0.02,
             "wheel {w}: sag {:.5} m, expected m·g/k = {expected:.5} m ({:.1} %)",
@@ -142,14 +145,20 @@ fn parked_on_slope_holds_below_friction_angle_and_slides_above() {
     for mu in [0.4f64, 0.7] {
         let critical = mu.atan().to_degrees();
         let (moved, speed) = parked(mu, critical - 1.5);
-        println!("μ {mu}: {:.1}° moved {moved:.4} m, speed {speed:.5}", critical - 1.5);
+        println!(
+            "μ {mu}: {:.1}° moved {moved:.4} m, speed {speed:.5}",
+            critical - 1.5
+        );
         assert!(
             moved.abs() < 0.01 && speed < 1e-3,
             "μ {mu}: at {:.1}° it moved {moved:.4} m, speed {speed:.4} m/s (should hold)",
             critical - 1.5
         );
         let (moved, speed) = parked(mu, critical + 1.5);
-        println!("μ {mu}: {:.1}° moved {moved:.4} m, speed {speed:.5}", critical + 1.5);
+        println!(
+            "μ {mu}: {:.1}° moved {moved:.4} m, speed {speed:.5}",
+            critical + 1.5
+        );
         assert!(
             moved < 0.0 && speed > 0.3,
             "μ {mu}: at {:.1}° it moved {moved:.3} m, speed {speed:.3} m/s (should slide down)",
@@ -243,7 +252,11 @@ fn tilt_table_rollover_angle() {
         let brake = Controls::new(0.0, 1.0, 0.0);
         let below = max_roll_on_side_slope(&spec, 0.95 * phi, 4.0, brake);
         let above = max_roll_on_side_slope(&spec, 1.05 * phi, 4.0, brake);
-        println!("{name}: φ {phi:.2}° (h {h:.4} m); max roll at 0.95φ {:.1}°, at 1.05φ {:.1}°", below.to_degrees(), above.to_degrees());
+        println!(
+            "{name}: φ {phi:.2}° (h {h:.4} m); max roll at 0.95φ {:.1}°, at 1.05φ {:.1}°",
+            below.to_degrees(),
+            above.to_degrees()
+        );
         assert!(
             below.to_degrees() < 0.95 * phi + 10.0,
             "{name}: at {:.1}° (0.95 φ, φ = {phi:.1}°) roll reached {:.1}°",
@@ -455,7 +468,10 @@ fn no_energy_gain_on_bumpy_terrain() {
             st.time()
         );
     }
-    println!("energy: start {e0:.1} J, end {:.1} J, largest rise {worst:.4} J (tolerance {tolerance:.2} J)", sim.energy(&st));
+    println!(
+        "energy: start {e0:.1} J, end {:.1} J, largest rise {worst:.4} J (tolerance {tolerance:.2} J)",
+        sim.energy(&st)
+    );
     assert!(
         sim.energy(&st) < e0,
         "energy did not decrease (worst rise {worst:.3} J)"
@@ -484,7 +500,10 @@ fn rock_stops_the_vehicle() {
         let front = sim.point_world(&st, Vec3::new(2.3, 0.0, 0.5));
         furthest = furthest.max(front.x);
     }
-    println!("rock: front reached {furthest:.3} m (face at {face} m), final speed {:.3} m/s", st.velocity_world().norm());
+    println!(
+        "rock: front reached {furthest:.3} m (face at {face} m), final speed {:.3} m/s",
+        st.velocity_world().norm()
+    );
     assert!(
         furthest < face + 0.5,
         "the front reached x = {furthest:.2} m, the rock face is at {face} m"
@@ -495,6 +514,42 @@ fn rock_stops_the_vehicle() {
         st.velocity_world().norm()
     );
     assert!(st.contacts().chassis_obstacle_points + st.contacts().wheel_obstacle_contacts > 0);
+}
+
+// 8a'. The same for a tree (a 0.3 m cylinder): the vehicle stops with its front short of the
+//      tree's centre (a 10 m/s vehicle moves 5 cm per internal step, the trunk is 60 cm thick).
+#[test]
+fn tree_stops_the_vehicle() {
+    let spec = hmmwv();
+    let tree_x = 12.0;
+    let (sim, mut st) = sim_at(
+        testing::tree_world(1.0, 0.8, tree_x, 0.3, 5.0),
+        &spec,
+        0.0,
+        0.0,
+        0.0,
+    );
+    st.set_velocity(&sim, Vec3::new(10.0, 0.0, 0.0));
+    let mut furthest: f64 = f64::NEG_INFINITY;
+    for _ in 0..400 {
+        // coasting in: with the throttle held the tyres push the body's nose up the trunk
+        sim.step(&mut st, Controls::IDLE, 0.01).unwrap();
+        furthest = furthest.max(sim.point_world(&st, Vec3::new(2.3, 0.0, 0.5)).x);
+    }
+    println!(
+        "tree: front reached {furthest:.3} m (trunk surface at {:.1} m), final speed {:.3} m/s",
+        tree_x - 0.3,
+        st.velocity_world().norm()
+    );
+    assert!(
+        furthest < tree_x,
+        "the front reached x = {furthest:.2} m, past the tree centre at {tree_x} m"
+    );
+    assert!(
+        st.velocity_world().norm() < 1.0,
+        "still moving at {:.2} m/s",
+        st.velocity_world().norm()
+    );
 }
 
 // 8b. Driving slowly across a high-friction side slope: steeper than the static rollover angle
@@ -509,7 +564,11 @@ fn side_slope_rollover_while_driving() {
     let drive = Controls::new(0.3, 0.0, 0.0);
     let below = max_roll_on_side_slope(&spec, 0.8 * phi, 6.0, drive);
     let above = max_roll_on_side_slope(&spec, 1.1 * phi, 6.0, drive);
-    println!("driving: max roll at 0.8φ {:.1}°, at 1.1φ {:.1}°", below.to_degrees(), above.to_degrees());
+    println!(
+        "driving: max roll at 0.8φ {:.1}°, at 1.1φ {:.1}°",
+        below.to_degrees(),
+        above.to_degrees()
+    );
     assert!(
         below.to_degrees() < 0.8 * phi + 10.0,
         "at 0.8 φ = {:.1}° roll reached {:.1}°",
