@@ -290,10 +290,10 @@ impl VehicleSpec {
         }
         pos("scale", self.scale)?;
         pos("internal_step", self.internal_step)?;
-        if self.internal_step > 0.01 {
+        if !(1e-5..=0.01).contains(&self.internal_step) {
             return Err(bad(
                 "internal_step".into(),
-                format!("{} s is too coarse (max 0.01 s)", self.internal_step),
+                format!("{} s is outside [1e-5, 0.01] s", self.internal_step),
             ));
         }
         let c = &self.chassis;
