@@ -79,7 +79,9 @@ impl EpisodeConfig {
         ];
         for (name, v, lo, hi) in checks {
             if !(v.is_finite() && v >= lo && v <= hi) {
-                return Err(format!("episode setting {name} = {v} is outside [{lo}, {hi}]"));
+                return Err(format!(
+                    "episode setting {name} = {v} is outside [{lo}, {hi}]"
+                ));
             }
         }
         Ok(())
@@ -99,7 +101,13 @@ pub enum Outcome {
 }
 
 impl Outcome {
-    pub const ALL: [Outcome; 5] = [Outcome::Success, Outcome::Rollover, Outcome::Stuck, Outcome::Timeout, Outcome::Error];
+    pub const ALL: [Outcome; 5] = [
+        Outcome::Success,
+        Outcome::Rollover,
+        Outcome::Stuck,
+        Outcome::Timeout,
+        Outcome::Error,
+    ];
     pub fn name(self) -> &'static str {
         match self {
             Outcome::Success => "success",
@@ -174,17 +182,160 @@ pub struct EpisodeLog {
     pub steps: Vec<StepRecord>,
 }
 
-fn pose6(sim: &Sim, state: &SimState) -> Pose6 {
+/// The success and failure rules of one trial, checked step by step. [`run_episode`] drives it
+/// after every inner step; step-wise users (the Python gym environment) drive the very same
+/// rules between their own physics steps, so the rules exist once.
+#[derive(Clone, Debug)]
+pub struct Termination {
+    rules: Rules,
+    goal: [f64; 2],
+    /// Reference rules: the goal point is raised 2 m (scaled) above the ground.
+    goal_z: f64,
+    /// Scaled success radius and stuck distance, metres.
+    success_radius: f64,
+    stuck_distance: f64,
+    stuck_window: f64,
+    max_time: f64,
+    rollover_deg: f64,
+    /// Paper stuck rule: (t, x, y) sampled every 0.1 s over the last window.
+    history: VecDeque<(f64, f64, f64)>,
+    next_sample: f64,
+    /// Reference stuck rule: how long the vehicle has been slower than 2 m/s.
+    slow_time: f64,
+    last_xyz: (f64, f64, f64),
+}
+
+impl Termination {
+    /// The rules of `cfg` for driving to `goal` on `world`, starting at `start` (time 0).
+    pub fn new(world: &World, goal: [f64; 2], cfg: &EpisodeConfig, start: &Pose6) -> Termination {
+        let scale = world.meta.scale;
+        Termination {
+            rules: cfg.rules,
+            goal,
+            goal_z: world.terrain.height_at(goal[0], goal[1]) + 2.0 * scale,
+            success_radius: cfg.success_radius * scale,
+            stuck_distance: cfg.stuck_distance * scale,
+            stuck_window: cfg.stuck_window,
+            max_time: cfg.max_time,
+            rollover_deg: cfg.rollover_deg,
+            history: VecDeque::new(),
+            next_sample: 0.0,
+            slow_time: 0.0,
+            last_xyz: (start.x, start.y, start.z),
+        }
+    }
+
+    /// Planar distance from `pose` to the goal, metres.
+    pub fn goal_distance(&self, pose: &Pose6) -> f64 {
+        ((pose.x - self.goal[0]).powi(2) + (pose.y - self.goal[1]).powi(2)).sqrt()
+    }
+
+    /// Checks the rules after a physics step of `dt` seconds that ended at simulated time `t`
+    /// with the vehicle at `pose`. Returns how the trial ends if it ends now: `Success`,
+    /// `Stuck` or `Timeout`. Whether a failure is a rollover is decided at the end by
+    /// [`Termination::classify`]. Call it after every step, in order, from the first one.
+    pub fn check(&mut self, t: f64, dt: f64, pose: &Pose6) -> Option<Outcome> {
+        let planar_goal = self.goal_distance(pose);
+        match self.rules {
+            Rules::Paper => {
+                if planar_goal < self.success_radius {
+                    return Some(Outcome::Success);
+                }
+                if t + 1e-9 >= self.next_sample {
+                    self.history.push_back((t, pose.x, pose.y));
+                    self.next_sample += 0.1;
+                    while self
+                        .history
+                        .front()
+                        .is_some_and(|h| h.0 < t - self.stuck_window - 1e-9)
+                    {
+                        self.history.pop_front();
+                    }
+                    let full_window = self
+                        .history
+                        .front()
+                        .is_some_and(|h| h.0 <= t - self.stuck_window + 0.1 + 1e-9);
+                    if full_window
+                        && self.history.iter().all(|h| {
+                            ((h.1 - pose.x).powi(2) + (h.2 - pose.y).powi(2)).sqrt()
+                                < self.stuck_distance
+                        })
+                    {
+                        return Some(Outcome::Stuck);
+                    }
+                }
+                if t >= self.max_time - 1e-9 {
+                    return Some(Outcome::Timeout);
+                }
+            }
+            Rules::VertiBench => {
+                let last = self.last_xyz;
+                let step = ((pose.x - last.0).powi(2)
+                    + (pose.y - last.1).powi(2)
+                    + (pose.z - last.2).powi(2))
+                .sqrt();
+                self.last_xyz = (pose.x, pose.y, pose.z);
+                // 0.01 m per 5 ms step is 2 m/s
+                if step / dt < 2.0 {
+                    self.slow_time += dt;
+                } else {
+                    self.slow_time = 0.0;
+                }
+                if self.slow_time >= self.stuck_window - 1e-9 {
+                    return Some(Outcome::Stuck);
+                }
+                let d3 = (planar_goal.powi(2) + (pose.z - self.goal_z).powi(2)).sqrt();
+                if d3 < 8.0 {
+                    return Some(Outcome::Success);
+                }
+                if t >= self.max_time - 1e-9 {
+                    return Some(Outcome::Timeout);
+                }
+            }
+        }
+        None
+    }
+
+    /// The final class of a trial that ended as `ended` with |roll| = `final_roll_deg` degrees
+    /// at its end: under the paper rules a failed trial beyond the rollover threshold is a
+    /// rollover; the reference rules have no rollover class.
+    pub fn classify(&self, ended: Outcome, final_roll_deg: f64) -> Outcome {
+        match ended {
+            Outcome::Success | Outcome::Error => ended,
+            _ if self.rules == Rules::Paper && final_roll_deg > self.rollover_deg => {
+                Outcome::Rollover
+            }
+            other => other,
+        }
+    }
+}
+
+/// The chassis pose the rules and systems see: reference-frame position and Z-Y-X Euler angles.
+pub fn pose6(sim: &Sim, state: &SimState) -> Pose6 {
     let p = sim.reference_pose(state).position;
     let (roll, pitch, yaw) = state.euler();
-    Pose6 { x: p.x, y: p.y, z: p.z, roll, pitch, yaw }
+    Pose6 {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+        roll,
+        pitch,
+        yaw,
+    }
 }
 
 /// Task information for a system.
 pub fn task_info(world: &World, spec: &VehicleSpec, pair: u32, seed: u64) -> Option<TaskInfo> {
     let task = world.tasks.iter().find(|t| t.pair == pair)?;
-    let id = TaskId { world: world.meta.index, pair };
-    let path = world.paths.get(world.tasks.iter().position(|t| t.pair == pair)?).map(|p| p.points.clone()).unwrap_or_default();
+    let id = TaskId {
+        world: world.meta.index,
+        pair,
+    };
+    let path = world
+        .paths
+        .get(world.tasks.iter().position(|t| t.pair == pair)?)
+        .map(|p| p.points.clone())
+        .unwrap_or_default();
     Some(TaskInfo {
         id,
         start: task.start,
@@ -210,9 +361,12 @@ pub fn run_episode(
 ) -> TrialResult {
     let wall = Instant::now();
     let info = task_info(world, spec, pair, cfg.seed);
-    let scale = world.meta.scale;
     let mut result = TrialResult {
-        task: TaskId { world: world.meta.index, pair }.number(),
+        task: TaskId {
+            world: world.meta.index,
+            pair,
+        }
+        .number(),
         world: world.meta.index,
         pair,
         world_name: world.meta.name.clone(),
@@ -242,13 +396,24 @@ pub fn run_episode(
         r
     };
     let Some(info) = info else {
-        return fail(result, format!("world {} has no pair {pair}", world.meta.name), wall);
+        return fail(
+            result,
+            format!("world {} has no pair {pair}", world.meta.name),
+            wall,
+        );
     };
     if let Err(e) = cfg.validate() {
         return fail(result, e, wall);
     }
-    let task = world.tasks.iter().find(|t| t.pair == pair).copied().expect("task_info found it");
-    let sim = match start_pose(world, spec, task.start[0], task.start[1], task.start_yaw()).and_then(|p| Sim::new(world, spec, p)) {
+    let task = world
+        .tasks
+        .iter()
+        .find(|t| t.pair == pair)
+        .copied()
+        .expect("task_info found it");
+    let sim = match start_pose(world, spec, task.start[0], task.start[1], task.start_yaw())
+        .and_then(|p| Sim::new(world, spec, p))
+    {
         Ok(s) => s,
         Err(e) => return fail(result, format!("cannot start the simulation: {e}"), wall),
     };
@@ -256,32 +421,44 @@ pub fn run_episode(
     system.reset(&info);
     let rate = system.control_rate();
     if !(rate.is_finite() && rate > 0.0 && rate <= 1000.0) {
-        return fail(result, format!("system {} has an invalid control rate {rate} Hz", system.name()), wall);
+        return fail(
+            result,
+            format!(
+                "system {} has an invalid control rate {rate} Hz",
+                system.name()
+            ),
+            wall,
+        );
     }
     let control_period = 1.0 / rate;
     let speed = SpeedController::default();
-    let goal_z = world.terrain.height_at(task.goal[0], task.goal[1]) + 2.0 * scale;
-    let success_radius = cfg.success_radius * scale;
-    let stuck_distance = cfg.stuck_distance * scale;
     let dt = cfg.inner_dt;
 
-    let mut action = Action::HighLevel { speed: 0.0, steering: 0.0 };
+    let mut action = Action::HighLevel {
+        speed: 0.0,
+        steering: 0.0,
+    };
     let mut next_control = 0.0;
-    // positions sampled every 0.1 s for the stuck rule (paper)
-    let mut history: VecDeque<(f64, f64, f64)> = VecDeque::new();
-    let mut next_sample = 0.0;
-    let mut slow_time = 0.0; // reference stuck rule
     let mut step_index: u64 = 0;
     let mut pose = pose6(&sim, &state);
     let mut last_xy = (pose.x, pose.y);
-    let mut last_xyz = (pose.x, pose.y, pose.z);
+    let mut rules = Termination::new(world, task.goal, cfg, &pose);
 
     let outcome = loop {
         let t = step_index as f64 * dt;
         // --- system at its own rate
         if t + 1e-9 >= next_control {
             let v_body = state.velocity_body();
-            let obs = Observation::new(world, t, pose, v_body, state.angular_velocity_body(), state.forward_speed(), task.goal, &info.global_path);
+            let obs = Observation::new(
+                world,
+                t,
+                pose,
+                v_body,
+                state.angular_velocity_body(),
+                state.forward_speed(),
+                task.goal,
+                &info.global_path,
+            );
             action = system.act(&obs);
             next_control += control_period;
             let ok = match action {
@@ -290,11 +467,21 @@ pub fn run_episode(
             };
             if !ok {
                 result.time = t;
-                return fail(result, format!("system {} returned an invalid action {action:?} at t = {t:.2} s", system.name()), wall);
+                return fail(
+                    result,
+                    format!(
+                        "system {} returned an invalid action {action:?} at t = {t:.2} s",
+                        system.name()
+                    ),
+                    wall,
+                );
             }
         }
         let controls: Controls = match action {
-            Action::HighLevel { speed: target, steering } => speed.controls(target, state.forward_speed(), steering),
+            Action::HighLevel {
+                speed: target,
+                steering,
+            } => speed.controls(target, state.forward_speed(), steering),
             Action::LowLevel(c) => c,
         };
         result.throttle.push(controls.throttle - controls.brake);
@@ -303,7 +490,11 @@ pub fn run_episode(
         // --- physics
         if let Err(e) = sim.step(&mut state, controls, dt) {
             result.time = t;
-            return fail(result, format!("simulation failed at t = {t:.2} s: {e}"), wall);
+            return fail(
+                result,
+                format!("simulation failed at t = {t:.2} s: {e}"),
+                wall,
+            );
         }
         step_index += 1;
         let t = step_index as f64 * dt;
@@ -344,66 +535,19 @@ pub fn run_episode(
         }
 
         // --- termination
-        let planar_goal = ((pose.x - task.goal[0]).powi(2) + (pose.y - task.goal[1]).powi(2)).sqrt();
-        match cfg.rules {
-            Rules::Paper => {
-                if planar_goal < success_radius {
-                    break Outcome::Success;
-                }
-                if t + 1e-9 >= next_sample {
-                    history.push_back((t, pose.x, pose.y));
-                    next_sample += 0.1;
-                    while history.front().is_some_and(|h| h.0 < t - cfg.stuck_window - 1e-9) {
-                        history.pop_front();
-                    }
-                    let full_window = history.front().is_some_and(|h| h.0 <= t - cfg.stuck_window + 0.1 + 1e-9);
-                    if full_window
-                        && history.iter().all(|h| ((h.1 - pose.x).powi(2) + (h.2 - pose.y).powi(2)).sqrt() < stuck_distance)
-                    {
-                        break Outcome::Stuck;
-                    }
-                }
-                if t >= cfg.max_time - 1e-9 {
-                    break Outcome::Timeout;
-                }
-            }
-            Rules::VertiBench => {
-                let step = ((pose.x - last_xyz.0).powi(2) + (pose.y - last_xyz.1).powi(2) + (pose.z - last_xyz.2).powi(2)).sqrt();
-                last_xyz = (pose.x, pose.y, pose.z);
-                // 0.01 m per 5 ms step is 2 m/s
-                if step / dt < 2.0 {
-                    slow_time += dt;
-                } else {
-                    slow_time = 0.0;
-                }
-                if slow_time >= cfg.stuck_window - 1e-9 {
-                    break Outcome::Stuck;
-                }
-                let d3 = (planar_goal.powi(2) + (pose.z - goal_z).powi(2)).sqrt();
-                if d3 < 8.0 {
-                    break Outcome::Success;
-                }
-                if t >= cfg.max_time - 1e-9 {
-                    break Outcome::Timeout;
-                }
-            }
+        if let Some(ended) = rules.check(t, dt, &pose) {
+            break ended;
         }
     };
     let t = step_index as f64 * dt;
     result.time = t;
-    result.final_distance = ((pose.x - task.goal[0]).powi(2) + (pose.y - task.goal[1]).powi(2)).sqrt();
+    result.final_distance =
+        ((pose.x - task.goal[0]).powi(2) + (pose.y - task.goal[1]).powi(2)).sqrt();
     result.final_roll = pose.roll.to_degrees().abs();
-    result.outcome = match outcome {
-        Outcome::Success => {
-            result.traversal_time = Some(t);
-            Outcome::Success
-        }
-        other if cfg.rules == Rules::Paper && result.final_roll > cfg.rollover_deg => {
-            let _ = other;
-            Outcome::Rollover
-        }
-        other => other,
-    };
+    result.outcome = rules.classify(outcome, result.final_roll);
+    if result.outcome == Outcome::Success {
+        result.traversal_time = Some(t);
+    }
     result.wall_time = wall.elapsed().as_secs_f64();
     result
 }

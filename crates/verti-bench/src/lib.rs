@@ -18,6 +18,6 @@ pub mod report;
 pub mod speed;
 pub mod system;
 
-pub use episode::{EpisodeConfig, Outcome, Rules, TrialResult, run_episode};
+pub use episode::{EpisodeConfig, Outcome, Rules, Termination, TrialResult, run_episode};
 pub use observation::{Crop, CropSpec, Observation};
 pub use system::{Action, MobilitySystem, TaskInfo};
