@@ -94,37 +94,42 @@ pub fn apportion(count: u32, weights: &[f64]) -> Vec<u32> {
     out
 }
 
-fn stratified<T: Copy>(rng: &mut Rng, count: u32, values: &[T], weights: &[f64]) -> Vec<T> {
-    let mut list = Vec::with_capacity(count as usize);
-    for (v, k) in values.iter().zip(apportion(count, weights)) {
-        list.extend(std::iter::repeat_n(*v, k as usize));
-    }
-    rng.shuffle(&mut list);
-    list
+/// Interleaves categories in exact proportions: at each position, the category furthest behind
+/// its target share (ties to the first) gets the slot, so every contiguous block of the result
+/// holds nearly the target mix. 100 slots at 6:3:1 give exactly 60/30/10.
+fn interleave<T: Copy>(count: usize, values: &[T], weights: &[f64]) -> Vec<T> {
+    let total: f64 = weights.iter().sum();
+    let mut assigned = vec![0usize; values.len()];
+    (0..count)
+        .map(|i| {
+            let deficit = |k: usize| weights[k] / total * (i + 1) as f64 - assigned[k] as f64;
+            let k = (0..values.len()).fold(0, |best, k| if deficit(k) > deficit(best) + 1e-12 { k } else { best });
+            assigned[k] += 1;
+            values[k]
+        })
+        .collect()
 }
 
 /// The (level, type, density) of every world of a set, in world order.
+///
+/// The design is balanced so that the breakdowns of the paper's Fig. 6 compare like with like:
+/// elevation level and obstacle density are crossed (each of the 9 cells gets 1/9 of the
+/// worlds, largest remainders first, so 100 worlds give 12 + 8 x 11 and the marginals are
+/// 34/33/33 each), and terrain types (60/30/10 %) are interleaved through the cells so every
+/// cell holds nearly the same type mix. The world order is then shuffled with the set seed.
 pub fn composition(config: &SetConfig) -> Vec<(ElevationLevel, TerrainType, ObstacleDensity)> {
     let mut rng = Rng::derive(config.seed, "composition", 0);
-    let levels = stratified(
-        &mut rng,
-        config.count,
-        &ElevationLevel::ALL,
-        &[1.0, 1.0, 1.0],
-    );
-    let types = stratified(&mut rng, config.count, &TerrainType::ALL, &[0.6, 0.3, 0.1]);
-    let densities = stratified(
-        &mut rng,
-        config.count,
-        &ObstacleDensity::ALL,
-        &[1.0, 1.0, 1.0],
-    );
-    levels
-        .into_iter()
-        .zip(types)
-        .zip(densities)
-        .map(|((l, t), d)| (l, t, d))
-        .collect()
+    let cells: Vec<(ElevationLevel, ObstacleDensity)> =
+        ElevationLevel::ALL.iter().flat_map(|&l| ObstacleDensity::ALL.iter().map(move |&d| (l, d))).collect();
+    let mut design = Vec::with_capacity(config.count as usize);
+    for (cell, k) in cells.iter().zip(apportion(config.count, &[1.0; 9])) {
+        design.extend(std::iter::repeat_n(*cell, k as usize));
+    }
+    let types = interleave(design.len(), &TerrainType::ALL, &[0.6, 0.3, 0.1]);
+    let mut worlds: Vec<(ElevationLevel, TerrainType, ObstacleDensity)> =
+        design.into_iter().zip(types).map(|((l, d), t)| (l, t, d)).collect();
+    rng.shuffle(&mut worlds);
+    worlds
 }
 
 /// The 10 start/goal pairs on the task circle: start k at k·36°, goal opposite.
@@ -264,6 +269,27 @@ mod tests {
         assert_eq!(apportion(100, &[0.6, 0.3, 0.1]), vec![60, 30, 10]);
         assert_eq!(apportion(7, &[0.6, 0.3, 0.1]), vec![4, 2, 1]);
         assert_eq!(apportion(1, &[1.0, 1.0, 1.0]).iter().sum::<u32>(), 1);
+    }
+
+    #[test]
+    fn composition_is_a_balanced_design() {
+        let comp = composition(&SetConfig::default());
+        let count = |f: &dyn Fn(&(ElevationLevel, TerrainType, ObstacleDensity)) -> bool| comp.iter().filter(|c| f(c)).count();
+        for l in ElevationLevel::ALL {
+            for d in ObstacleDensity::ALL {
+                let n = count(&|c| c.0 == l && c.2 == d);
+                assert!((11..=12).contains(&n), "{l} x {d}: {n}");
+            }
+            // each level holds 20 ± 1 rigid, 10 ± 1 deformable and 3 ± 1 mixed worlds
+            let rigid = count(&|c| c.0 == l && c.1 == TerrainType::Rigid);
+            let soil = count(&|c| c.0 == l && c.1 == TerrainType::Deformable);
+            let mixed = count(&|c| c.0 == l && c.1 == TerrainType::Mixed);
+            assert!((19..=21).contains(&rigid) && (9..=11).contains(&soil) && (2..=4).contains(&mixed), "{l}: {rigid} {soil} {mixed}");
+        }
+        assert_eq!(count(&|c| c.1 == TerrainType::Rigid), 60);
+        assert_eq!(count(&|c| c.1 == TerrainType::Mixed), 10);
+        // traced by hand: ties (i = 3: 0.4 vs 0.4; i = 4: 0.5 vs 0.5) go to the first category
+        assert_eq!(interleave(10, &[0u8, 1, 2], &[0.6, 0.3, 0.1]), vec![0, 1, 0, 0, 1, 0, 2, 0, 1, 0]);
     }
 
     #[test]
