@@ -1,5 +1,7 @@
 //! Development trace of the benchmark drive: `cargo run -p verti-sim --release --example trace -- hmmwv soil`
-use verti_sim::{BenchWorlds, Sim, bench::bench_controls, start_pose, vehicles};
+use verti_sim::{
+    BenchWorlds, Sim, bench::bench_controls, bench::bench_route, start_pose, vehicles,
+};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -15,15 +17,17 @@ fn main() {
     } else {
         &pair.rigid
     };
+    let (from, to) = bench_route(world);
+    let yaw0 = (to[1] - from[1]).atan2(to[0] - from[0]);
     let sim = Sim::new(
         world,
         &spec,
-        start_pose(world, &spec, 0.0, 0.0, 0.3).unwrap(),
+        start_pose(world, &spec, from[0], from[1], yaw0).unwrap(),
     )
     .unwrap();
     let mut st = sim.initial_state();
     for k in 0..3000 {
-        let c = bench_controls(st.time(), st.forward_speed(), world.meta.scale);
+        let c = bench_controls(&st, to, world.meta.scale);
         if let Err(e) = sim.step(&mut st, c, 0.02) {
             println!("error {e}");
             break;

@@ -2,7 +2,7 @@
 //! `verti sim soak`.
 
 use crate::error::SimError;
-use crate::sim::{Controls, Sim, start_pose};
+use crate::sim::{Controls, Sim, SimState, start_pose};
 use crate::spec::VehicleSpec;
 use crate::testing::{RoughSurface, rough_world};
 use serde::{Deserialize, Serialize};
@@ -175,20 +175,36 @@ impl fmt::Display for BenchReport {
     }
 }
 
-/// The fixed scripted input of the benchmark: Verti-Bench's speed controller (proportional,
-/// gain 1, throttle or brake) toward 4 m/s (scaled with √scale), and a slow left weave that
-/// keeps the vehicle circling near the map centre.
-pub fn bench_controls(t: f64, forward_speed: f64, scale: f64) -> Controls {
-    let u = (4.0 * scale.sqrt() - forward_speed).clamp(-1.0, 1.0);
+/// The benchmark's route: the first task's start (a spot the generator keeps clear of
+/// obstacles) and its goal, or, for worlds without tasks, a chord through the map centre.
+pub fn bench_route(world: &World) -> ([f64; 2], [f64; 2]) {
+    match world.tasks.first() {
+        Some(t) => (t.start, t.goal),
+        None => {
+            let r = 0.4 * world.terrain.half_extent();
+            ([-r, 0.0], [r, 0.0])
+        }
+    }
+}
+
+/// The fixed scripted driver of the benchmark, like Verti-Bench's PID system: Verti-Bench's
+/// proportional speed controller (gain 1, throttle or brake) toward 4 m/s (scaled by √scale),
+/// and proportional steering toward `target`.
+pub fn bench_controls(state: &SimState, target: [f64; 2], scale: f64) -> Controls {
+    let u = (4.0 * scale.sqrt() - state.forward_speed()).clamp(-1.0, 1.0);
+    let p = state.com_position();
+    let (_, _, yaw) = state.euler();
+    let bearing = (target[1] - p.y).atan2(target[0] - p.x);
+    let steering = (2.0 * verti_core::math::wrap_angle(bearing - yaw)).clamp(-1.0, 1.0);
     Controls {
         throttle: u.max(0.0),
         brake: (-u).max(0.0),
-        steering: 0.35 + 0.25 * (0.25 * t).sin(),
+        steering,
     }
 }
 
 /// Drives each vehicle for `sim_seconds` on the rigid and the soil world of its scale with
-/// [`bench_controls`] at a 50 Hz control rate, `runs` times, single-threaded, and reports the
+/// [`bench_controls`] along [`bench_route`] at a 50 Hz control rate, `runs` times, single-threaded, and reports the
 /// median real-time factor per case.
 pub fn bench(
     worlds: &BenchWorlds,
@@ -208,8 +224,10 @@ pub fn bench(
             let mut error = None;
             let mut distance = 0.0;
             let mut steps = 0;
-            let setup =
-                start_pose(world, spec, 0.0, 0.0, 0.3).and_then(|p| Sim::new(world, spec, p));
+            let (from, to) = bench_route(world);
+            let yaw0 = (to[1] - from[1]).atan2(to[0] - from[0]);
+            let setup = start_pose(world, spec, from[0], from[1], yaw0)
+                .and_then(|p| Sim::new(world, spec, p));
             let sim = match setup {
                 Ok(s) => s,
                 Err(e) => {
@@ -237,9 +255,15 @@ pub fn bench(
                 let mut state = sim.initial_state();
                 let start = state.com_position();
                 let t0 = Instant::now();
+                // shuttle between the route's ends, turning back within 8 m (scaled) of each
+                let mut target = to;
+                let arrive = 8.0 * world.meta.scale;
                 for _ in 0..n {
-                    let controls =
-                        bench_controls(state.time(), state.forward_speed(), world.meta.scale);
+                    let p = state.com_position();
+                    if (p.x - target[0]).hypot(p.y - target[1]) < arrive {
+                        target = if target == to { from } else { to };
+                    }
+                    let controls = bench_controls(&state, target, world.meta.scale);
                     if let Err(e) = sim.step(&mut state, controls, control_dt) {
                         error = Some(e.to_string());
                         break;
