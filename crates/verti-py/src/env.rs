@@ -829,8 +829,17 @@ impl VecCore {
         self.envs.is_empty()
     }
 
-    /// Resets every environment; environment i gets seed `seed + i` when a seed is given.
-    pub fn reset(&mut self, seed: Option<u64>) -> Result<(), String> {
+    /// Resets every environment, environment i with `seeds[i]` when seeds are given.
+    pub fn reset(&mut self, seeds: Option<&[u64]>) -> Result<(), String> {
+        if let Some(s) = seeds
+            && s.len() != self.envs.len()
+        {
+            return Err(format!(
+                "expected {} seeds (one per environment), got {}",
+                self.envs.len(),
+                s.len()
+            ));
+        }
         let envs = &mut self.envs;
         let obs = &mut self.obs;
         self.pool.install(|| {
@@ -838,7 +847,7 @@ impl VecCore {
                 .zip(obs.par_iter_mut())
                 .enumerate()
                 .try_for_each(|(i, (env, buf))| {
-                    env.reset(seed.map(|s| s.wrapping_add(i as u64)), None)?;
+                    env.reset(seeds.map(|s| s[i]), None)?;
                     env.observe(buf)
                 })
         })?;
@@ -1021,7 +1030,7 @@ mod tests {
 
         // a vector of 3 stepped in parallel equals the same environments stepped one by one
         let mut v = VecCore::new(a.sibling(0), 3, 2).unwrap();
-        v.reset(Some(5)).unwrap();
+        v.reset(Some(&[5, 6, 7])).unwrap();
         let mut serial: Vec<EnvCore> = (0..3).map(|i| a.sibling(0).tap_reset(5 + i)).collect();
         for k in 0..15 {
             let acts: Vec<f64> = (0..3)

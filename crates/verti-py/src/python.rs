@@ -458,6 +458,14 @@ impl PyWorld {
         })
     }
 
+    /// Worlds are immutable: a copy is the same world (gymnasium deep-copies make() kwargs).
+    fn __copy__(slf: Bound<'_, Self>) -> Bound<'_, Self> {
+        slf
+    }
+    fn __deepcopy__<'py>(slf: Bound<'py, Self>, _memo: &Bound<'py, PyAny>) -> Bound<'py, Self> {
+        slf
+    }
+
     fn __hash__(&self) -> u64 {
         Arc::as_ptr(&self.inner) as u64
     }
@@ -973,6 +981,30 @@ fn results_to_py(py: Python<'_>, results: &[TrialResult]) -> PyResult<Vec<Py<PyA
         .collect()
 }
 
+/// System parameters: None, a dict name -> number, or a list of (name, number) pairs.
+fn params_arg(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String, f64)>> {
+    let Some(arg) = arg.filter(|a| !a.is_none()) else {
+        return Ok(Vec::new());
+    };
+    let bad = || {
+        PyTypeError::new_err(
+            "params must be a dict of parameter name -> number, e.g. {'speed': 4.0}",
+        )
+    };
+    if let Ok(d) = arg.cast::<PyDict>() {
+        return d
+            .iter()
+            .map(|(k, v)| {
+                Ok((
+                    k.extract::<String>().map_err(|_| bad())?,
+                    v.extract::<f64>().map_err(|_| bad())?,
+                ))
+            })
+            .collect();
+    }
+    arg.extract::<Vec<(String, f64)>>().map_err(|_| bad())
+}
+
 /// Runs `system` on the selected tasks, `jobs` trials at a time, and returns one dict per
 /// trial (the fields of `results.jsonl`), sorted by task. With `out`, results are also written
 /// there, resumable like `verti eval`. Ctrl-C stops it.
@@ -986,7 +1018,7 @@ fn evaluate(
     tasks: Option<&Bound<'_, PyAny>>,
     jobs: Option<usize>,
     vehicle: &str,
-    params: Option<Vec<(String, f64)>>,
+    params: Option<&Bound<'_, PyAny>>,
     rules: &str,
     max_time: f64,
     seed: u64,
@@ -995,7 +1027,7 @@ fn evaluate(
     resume: bool,
     force: bool,
 ) -> PyResult<Vec<Py<PyAny>>> {
-    let params = params.unwrap_or_default();
+    let params = params_arg(params)?;
     // build one system up front so unknown names and bad parameters fail before any work
     verti_systems::create(system, &params).map_err(value_err)?;
     let spec = vehicle_spec(vehicle)?;
@@ -1712,15 +1744,26 @@ impl PyVecEnvCore {
         })
     }
 
-    /// Resets every environment (environment i gets seed + i); returns (observations, infos).
+    /// Resets every environment: `seed` None (continue each sampler), an int (environment i
+    /// gets seed + i, gymnasium's convention) or one seed per environment. Returns
+    /// (observations, infos).
     #[pyo3(signature = (seed = None))]
     fn reset<'py>(
         &mut self,
         py: Python<'py>,
-        seed: Option<u64>,
+        seed: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+        let n = self.v.len() as u64;
+        let seeds: Option<Vec<u64>> = match seed {
+            None => None,
+            Some(s) if s.is_none() => None,
+            Some(s) => match s.extract::<u64>() {
+                Ok(base) => Some((0..n).map(|i| base.wrapping_add(i)).collect()),
+                Err(_) => Some(s.extract::<Vec<u64>>().map_err(|_| PyTypeError::new_err("seed must be None, a non-negative int or a list of them, one per environment"))?),
+            },
+        };
         let v = &mut self.v;
-        detached(py, || v.reset(seed))?.map_err(value_err)?;
+        detached(py, || v.reset(seeds.as_deref()))?.map_err(value_err)?;
         Ok((self.batch_obs(py)?, self.batch_info(py)?))
     }
 

@@ -1,0 +1,241 @@
+"""Worlds, the simulator and evaluation from Python."""
+
+import math
+import os
+
+import numpy as np
+import pytest
+
+import verti
+
+
+def test_world_arrays_are_views_without_copies(world):
+    h = world.heights
+    assert h.shape == (world.size, world.size) == (129, 129)
+    assert h.dtype == np.float64
+    # a read-only view of the world's own memory: same buffer on every access, no copy
+    assert not h.flags.writeable and not h.flags.owndata
+    assert h.__array_interface__["data"][0] == world.heights.__array_interface__["data"][0]
+    with pytest.raises(ValueError):
+        h[0, 0] = 1.0
+    # the view keeps the world alive
+    w2 = verti.World.generate(seed=0, index=2)
+    h2 = w2.heights
+    expected = h2.copy()
+    del w2
+    assert np.array_equal(h2, expected)
+    # matches the interpolated surface at the vertices: row 0 north, column 0 west
+    half = world.half_extent
+    assert world.height_at(-half, half) == pytest.approx(h[0, 0])
+    assert world.height_at(half, -half) == pytest.approx(h[-1, -1])
+    labels = world.labels
+    assert labels.shape == h.shape and labels.dtype == np.uint8 and labels.max() <= 9
+
+
+def test_world_metadata_tasks_paths_obstacles(world):
+    assert world.index == 1 and world.name == "verti-100/001"
+    assert world.level in ("low", "mid", "high")
+    assert world.terrain_type in ("rigid", "deformable", "mixed")
+    assert world.density in ("sparse", "medium", "dense")
+    assert world.cell == 1.0 and world.scale == 1.0
+    tasks = world.tasks
+    assert [t["pair"] for t in tasks] == list(range(10))
+    assert [t["task"] for t in tasks] == list(range(1, 11))
+    assert tasks[0]["distance"] == pytest.approx(120.0)
+    path = world.path(0)
+    assert path.shape[1] == 2 and len(path) >= 2
+    assert np.allclose(path[0], tasks[0]["start"], atol=1.5) and np.allclose(path[-1], tasks[0]["goal"], atol=1.5)
+    obstacles = world.obstacles
+    assert obstacles and {o["kind"] for o in obstacles} <= {"rock", "tree"}
+    assert obstacles[0]["footprint"].shape[1] == 2
+    assert "verti-100/001" in repr(world)
+
+
+def test_generate_is_deterministic_and_matches_resolve(world):
+    again = verti.World.generate(seed=0, index=1)
+    assert again == world and again is not world
+    assert np.array_equal(again.heights, world.heights)
+    named = verti.World.resolve("verti-100:1")
+    assert named == world
+    other = verti.World.generate(seed=1, index=1)
+    assert not np.array_equal(other.heights, world.heights)
+
+
+def test_save_load_round_trip(world, tmp_path):
+    world.save(str(tmp_path / "w"))
+    loaded = verti.World.load(str(tmp_path / "w"))
+    assert np.array_equal(loaded.heights, world.heights)
+    assert np.array_equal(loaded.labels, world.labels)
+    assert loaded.tasks == world.tasks
+
+
+# original Verti-Bench worlds, shipped beside the repository in shared/ (absent elsewhere)
+VB_DIR = os.path.join(os.path.dirname(__file__), "..", "..", "..", "shared", "verti-bench-data", "worlds")
+
+
+@pytest.mark.skipif(not os.path.isdir(VB_DIR), reason="shared/verti-bench-data is absent")
+def test_import_verti_bench_world(tmp_path):
+    config = os.path.join(VB_DIR, "config12_high.yaml")
+    bmp = os.path.join(VB_DIR, "world12.bmp")
+    labels = os.path.join(VB_DIR, "labels12_high.npy")
+    w = verti.World.import_verti_bench(config, bmp, labels)
+    assert w.index == 12 and w.level == "high" and w.heights.shape == (129, 129)
+    assert w.heights.max() <= 16.0 + 1e-9 and len(w.tasks) == 10
+    # the imported labels are the file's labels
+    assert np.array_equal(w.labels, np.load(labels).astype(np.uint8))
+    half = verti.World.import_verti_bench(config, bmp, scale=0.5)
+    assert half.half_extent == pytest.approx(w.half_extent / 2)
+    with pytest.raises(FileNotFoundError, match="nope.yaml"):
+        verti.World.import_verti_bench(str(tmp_path / "nope.yaml"), bmp)
+
+
+def test_sim_step_state_clone(world):
+    sim = verti.Sim(world, "hmmwv", start=0)
+    s0 = sim.state
+    assert s0.time == 0.0 and len(s0.vector) == len(verti.SIM_STATE_FIELDS)
+    start = world.tasks[0]["start"]
+    assert s0.pose[0] == pytest.approx(start[0]) and s0.pose[1] == pytest.approx(start[1])
+    for _ in range(100):
+        sim.step(throttle=0.6, brake=0.0, steering=0.0)
+    assert sim.time == pytest.approx(1.0)
+    assert sim.state.forward_speed > 0.5
+    # clone: independent copies that evolve identically
+    other = sim.clone()
+    for _ in range(50):
+        sim.step(0.5, 0.0, 0.2)
+        other.step(0.5, 0.0, 0.2)
+    assert np.array_equal(sim.state.vector, other.state.vector)
+    other.step(0.0, 1.0, 0.0)
+    assert other.time > sim.time
+    # restore a snapshot
+    snap = sim.state
+    sim.step(1.0, 0.0, -0.5, dt=0.5)
+    sim.state = snap
+    assert np.array_equal(sim.state.vector, snap.vector)
+    sim.reset()
+    assert sim.time == 0.0
+    d = snap.to_dict()
+    assert set(d) == set(verti.SIM_STATE_FIELDS)
+
+
+def test_sim_rollout_matches_steps(world):
+    a = verti.Sim(world, "hmmwv", start=(0.0, 0.0, math.pi / 4))
+    b = a.clone()
+    controls = np.tile([0.7, 0.0, 0.1], (30, 1))
+    rows = a.rollout(controls, dt=0.01)
+    for c in controls:
+        b.step(*c, dt=0.01)
+    assert rows.shape == (30, len(verti.SIM_STATE_FIELDS))
+    assert np.array_equal(rows[-1], b.state.vector)
+
+
+def test_sim_rejects_bad_input(world):
+    sim = verti.Sim(world)
+    with pytest.raises(ValueError, match="invalid control `throttle` = 1.5"):
+        sim.step(1.5, 0.0, 0.0)
+    with pytest.raises(ValueError, match="invalid control `steering` = NaN"):
+        sim.step(0.0, 0.0, float("nan"))
+    with pytest.raises(ValueError, match="invalid step dt"):
+        sim.step(0.5, 0.0, 0.0, dt=-1.0)
+    with pytest.raises(ValueError, match="unknown vehicle `tank`; built-in vehicles are: hmmwv"):
+        verti.Sim(world, "tank")
+    with pytest.raises(ValueError, match="off the map"):
+        verti.Sim(world, start=(1000.0, 0.0, 0.0))
+    with pytest.raises(ValueError, match="no pair 12"):
+        verti.Sim(world, start=12)
+    with pytest.raises(TypeError):
+        verti.Sim(world, start="north")
+    other = verti.Sim(world, start=1)
+    with pytest.raises(ValueError, match="belongs to another simulation"):
+        sim.state = other.state
+    with pytest.raises(ValueError, match="3 columns"):
+        sim.rollout(np.zeros((4, 2)))
+    assert sim.time == 0.0  # nothing above changed the state
+
+
+def test_vehicles_and_systems():
+    assert "hmmwv" in verti.vehicles()
+    names = [s["name"] for s in verti.systems()]
+    assert names == ["pid", "eh", "mppi"]
+    pid = verti.systems()[0]
+    assert any(p["name"] == "speed" for p in pid["params"])
+
+
+def test_world_errors_have_rust_messages(tmp_path):
+    with pytest.raises(FileNotFoundError, match="missing: No such file"):
+        verti.World.load(str(tmp_path / "missing"))
+    with pytest.raises(ValueError, match="has indices 1..=100, not 101"):
+        verti.World.generate(index=101)
+    with pytest.raises(ValueError, match="scale"):
+        verti.World.generate(scale=-1.0)
+    with pytest.raises(ValueError, match="unknown world set `nothing-here`"):
+        verti.load_worlds("nothing-here")
+    with pytest.raises(OverflowError):
+        verti.World.generate(seed=-1)
+
+
+def test_evaluate_returns_trials_and_a_table(world):
+    results = verti.evaluate("pid", [world], tasks=[1, 2], jobs=2, max_time=8.0)
+    assert [r["task"] for r in results] == [1, 2]
+    r = results[0]
+    assert r["system"] == "pid" and r["vehicle"] == "hmmwv" and r["world"] == 1
+    assert r["outcome"] in verti.OUTCOMES and r["time"] == pytest.approx(8.0) and r["outcome"] == "timeout"
+    assert r["path_length"] > 5.0
+    # identical for any number of jobs (only the wall time differs)
+    again = verti.evaluate("pid", [world], tasks="1-2", jobs=1, max_time=8.0)
+    strip = lambda rs: [{k: v for k, v in x.items() if k != "wall_time"} for x in rs]  # noqa: E731
+    assert strip(again) == strip(results)
+    table = verti.results_table(results)
+    assert table["task"] == [1, 2] and table["roll_abs_mean"][0] == r["roll"]["abs"]["mean"]
+    assert len({len(c) for c in table.values()}) == 1
+
+
+def test_evaluate_writes_a_resumable_results_folder(world, tmp_path):
+    out = tmp_path / "run"
+    first = verti.evaluate("pid", [world], tasks=[3], jobs=1, max_time=3.0, out=str(out))
+    assert (out / "results.jsonl").is_file() and len(first) == 1
+    with pytest.raises(ValueError, match="already exists"):
+        verti.evaluate("pid", [world], tasks=[3], jobs=1, max_time=3.0, out=str(out))
+    both = verti.evaluate("pid", [world], tasks=[3, 4], jobs=1, max_time=3.0, out=str(out), resume=True)
+    assert [r["task"] for r in both] == [3, 4]
+    assert both[0] == first[0]  # resumed, not rerun
+
+
+def test_evaluate_rejects_bad_arguments(world):
+    with pytest.raises(ValueError, match="unknown system `nope`"):
+        verti.evaluate("nope", [world])
+    with pytest.raises(ValueError, match="pid parameter speed = 100"):
+        verti.evaluate("pid", [world], params={"speed": 100.0})
+    with pytest.raises(ValueError, match="not in this world set"):
+        verti.evaluate("pid", [world], tasks=[500])
+    with pytest.raises(ValueError, match="bad task range"):
+        verti.evaluate("pid", [world], tasks="3-1")
+    with pytest.raises(ValueError, match="jobs must be at least 1"):
+        verti.evaluate("pid", [world], jobs=0)
+    with pytest.raises(ValueError, match="max_time"):
+        verti.evaluate("pid", [world], max_time=-5.0)
+    with pytest.raises(ValueError, match="unknown rules"):
+        verti.evaluate("pid", [world], rules="strict")
+    with pytest.raises(TypeError):
+        verti.evaluate("pid", [1, 2, 3])
+
+
+@pytest.mark.skipif(os.name != "posix", reason="uses SIGALRM")
+def test_ctrl_c_interrupts_a_long_evaluation(world):
+    import signal
+    import time
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    signal.setitimer(signal.ITIMER_REAL, 0.5)
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            # 10 MPPI trials of up to 600 simulated seconds: minutes of work
+            verti.evaluate("mppi", [world], jobs=1, max_time=600.0)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    assert time.perf_counter() - t0 < 5.0
