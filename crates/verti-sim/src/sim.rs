@@ -1555,6 +1555,10 @@ impl Sim {
                 continue;
             }
             let fo = &self.fast_obstacles[k as usize];
+            let reach3 = fo.radius + r + m.half_width;
+            if (hub - fo.center).norm_sq() > reach3 * reach3 {
+                continue;
+            }
             let (d_hub, n_hub) = fo.signed_distance(hub);
             if d_hub > r + m.half_width {
                 continue;
@@ -1859,16 +1863,21 @@ impl Sim {
                 }
                 continue;
             }
-            // chassis points inside the obstacle
+            // chassis points inside the obstacle (outside its bounding sphere: skip)
+            let r2 = fo.radius * fo.radius;
             for p in &pts {
+                if (*p - fo.center).norm_sq() > r2 {
+                    continue;
+                }
                 let (d, n) = fo.signed_distance(*p);
                 if d < 0.0 && apply(*p, n, -d, mu_obs, OBSTACLE_STIFFENING) {
                     contacts.chassis_obstacle_points += 1;
                 }
             }
             // obstacle vertices inside the chassis box (a rock edge poking into a flat side)
+            let rt = rm.transpose();
             for v in o.vertices() {
-                let local = q.inverse_rotate(*v - st.position) - self.box_center;
+                let local = rt.mul_vec(*v - st.position) - self.box_center;
                 let d = Vec3::new(
                     self.box_half.x - local.x.abs(),
                     self.box_half.y - local.y.abs(),

@@ -265,6 +265,9 @@ pub struct FastObstacle {
     pub faces: Vec<(verti_core::Vec3, f64)>,
     /// Tree: (centre x, centre y, radius, z min, z max).
     pub tree: Option<(f64, f64, f64, f64, f64)>,
+    /// Centre and radius of a sphere containing a rock (points outside cannot be inside).
+    pub center: verti_core::Vec3,
+    pub radius: f64,
 }
 
 impl FastObstacle {
@@ -280,13 +283,26 @@ impl FastObstacle {
                         (n, f.offset + n.dot(p))
                     })
                     .collect();
-                FastObstacle { faces, tree: None }
+                let center = p;
+                let radius = o
+                    .vertices()
+                    .iter()
+                    .map(|v| (*v - center).norm())
+                    .fold(0.0, f64::max);
+                FastObstacle {
+                    faces,
+                    tree: None,
+                    center,
+                    radius,
+                }
             }
             verti_world::ObstacleShape::Tree { radius, height } => {
                 let p = o.position();
                 FastObstacle {
                     faces: Vec::new(),
                     tree: Some((p.x, p.y, *radius, p.z - 0.5 * height, p.z + 0.5 * height)),
+                    center: p,
+                    radius: (radius * radius + 0.25 * height * height).sqrt(),
                 }
             }
         }
