@@ -1454,6 +1454,15 @@ impl Sim {
             .max_in(hub.x - r, hub.y - r, hub.x + r, hub.y + r);
         let near_ground = lowest_z < ground_max;
 
+        // Soil needs a grid that resolves the wheel: a tread narrower than the node spacing
+        // (a 1/10 vehicle on a full-scale world) could fall between nodes, and a wheel far too
+        // big for it would visit thousands. Both cases drive on the soil as rigid ground.
+        let soil_as_rigid = self.soil.is_none_or(|l| {
+            let span = (2.0 * r + 2.0 * m.half_width) / l.delta + 2.0;
+            span * span > MAX_SOIL_NODES_PER_WHEEL as f64
+                || 2.0 * m.half_width < l.delta
+                || r < 1.5 * l.delta
+        });
         let mut best_depth = 0.0;
         let mut best_normal = Vec3::Z;
         let mut best_mu = 1.0;
@@ -1488,8 +1497,9 @@ impl Sim {
                 }
                 let mu = match patches[ground.patch_index(p.x, p.y)].surface {
                     Surface::Rigid { friction, .. } => friction,
-                    // beyond the map edge there are no soil nodes: the ground acts rigid there
-                    Surface::Deformable { soil } if !hf.contains(p.x, p.y) => {
+                    // beyond the map edge there are no soil nodes, and a soil grid that cannot
+                    // resolve this wheel (see `soil_as_rigid`): the ground acts rigid there
+                    Surface::Deformable { soil } if soil_as_rigid || !hf.contains(p.x, p.y) => {
                         soil.friction_angle_deg.to_radians().tan()
                     }
                     Surface::Deformable { .. } => {
@@ -1580,7 +1590,10 @@ impl Sim {
             c.obstacle = true;
         }
 
-        if soil_here && let Some(layout) = self.soil {
+        if soil_here
+            && !soil_as_rigid
+            && let Some(layout) = self.soil
+        {
             self.soil_contact(st, &layout, m, soil_b, hub, axle, v_hub, up, &mut c);
         }
         c

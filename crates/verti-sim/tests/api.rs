@@ -219,3 +219,51 @@ fn soil_is_copy_on_write_and_ruts_persist() {
     assert!(!other.soil().shares_storage_with(st.soil()));
     assert_eq!(st, before, "stepping a clone must not touch the original");
 }
+
+#[test]
+fn a_vehicle_too_big_for_the_soil_grid_drives_on_it_as_rigid_ground() {
+    // HMMWV on a 1/10-scale soil world: 1 cm nodes, tens of thousands under each wheel
+    let world = Arc::new(testing::soil_world(0.1, SoilParams::MID, 0.0));
+    let spec = vehicles::builtin("hmmwv").unwrap();
+    let sim = Sim::new(
+        &world,
+        &spec,
+        start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
+    )
+    .unwrap();
+    let mut st = sim.initial_state();
+    for _ in 0..100 {
+        sim.step(&mut st, Controls::new(0.3, 0.0, 0.0), 0.02)
+            .unwrap();
+    }
+    assert_eq!(st.contacts().wheels_in_contact, 4);
+    assert!(
+        st.com_position().z > 0.4,
+        "sank to {:.3} m",
+        st.com_position().z
+    );
+}
+
+#[test]
+fn a_vehicle_too_small_for_the_soil_grid_does_not_fall_through() {
+    // 1/10 crawler on a full-scale soil world: 0.1 m nodes, a 4 cm tread
+    let world = Arc::new(testing::soil_world(1.0, SoilParams::SOFT, 0.0));
+    let spec = vehicles::builtin("verti4").unwrap();
+    let sim = Sim::new(
+        &world,
+        &spec,
+        start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
+    )
+    .unwrap();
+    let mut st = sim.initial_state();
+    for _ in 0..100 {
+        sim.step(&mut st, Controls::new(0.3, 0.0, 0.0), 0.02)
+            .unwrap();
+    }
+    assert_eq!(st.contacts().wheels_in_contact, 4);
+    assert!(
+        st.com_position().z > 0.05,
+        "sank to {:.3} m",
+        st.com_position().z
+    );
+}
