@@ -9,6 +9,11 @@ import verti
 from verti.envs import NavigateEnv
 
 
+# the checker warns about the unbounded (infinite) Box limits of the float observations
+CHECKER_BOUNDS = "ignore:.*Box observation space (minimum|maximum) value is"
+
+
+@pytest.mark.filterwarnings(CHECKER_BOUNDS)
 def test_registered_and_passes_the_env_checker(world):
     assert "verti/Navigate-v0" in gym.registry
     env = gym.make("verti/Navigate-v0", world=world, render_mode="rgb_array")
@@ -16,6 +21,8 @@ def test_registered_and_passes_the_env_checker(world):
     env.close()
 
 
+@pytest.mark.filterwarnings(CHECKER_BOUNDS)
+@pytest.mark.filterwarnings("ignore:.*Not able to test alternative render modes")
 def test_checker_passes_with_patches_and_low_level_actions(world):
     env = NavigateEnv(world, action_mode="low", elevation=16, semantic=(8, 0.5), occupancy=(8, 1.0))
     check_env(env)
@@ -157,7 +164,8 @@ def test_render_draws_the_trail(world):
         env.step([1.0, 0.3])
     later = env.render()
     assert later.shape == first.shape and (later != first).any()
-    assert NavigateEnv(world).render() is None
+    with pytest.warns(UserWarning, match="without render_mode"):
+        assert NavigateEnv(world).render() is None
 
 
 def test_bad_arguments_raise_clear_errors(world):
