@@ -925,7 +925,6 @@ impl VecCore {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use verti_bench::MobilitySystem;
     use verti_bench::episode::{run_episode, task_info};
     use verti_world::generate::{
         SetConfig, composition, elevation::ProceduralRock, generate_world,

@@ -122,17 +122,15 @@ fn interruptible<T: Send>(
                 r
             });
             let mut interrupted: Option<PyErr> = None;
-            loop {
-                match rx.recv_timeout(Duration::from_millis(50)) {
-                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
-                        if interrupted.is_none()
-                            && let Err(e) = Python::attach(|py| py.check_signals())
-                        {
-                            cancel.store(true, Ordering::SeqCst);
-                            interrupted = Some(e);
-                        }
-                    }
-                    _ => break,
+            // until the worker reports (or is gone), poll for signals between waits
+            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) =
+                rx.recv_timeout(Duration::from_millis(50))
+            {
+                if interrupted.is_none()
+                    && let Err(e) = Python::attach(|py| py.check_signals())
+                {
+                    cancel.store(true, Ordering::SeqCst);
+                    interrupted = Some(e);
                 }
             }
             let outcome = handle.join().unwrap_or_else(Err);
@@ -403,7 +401,7 @@ impl PyWorld {
             .map(|p| p.points.iter().flatten().copied().collect())
             .unwrap_or_default();
         let n = pts.len() / 2;
-        Ok(PyArray1::from_vec(py, pts).reshape([n, 2])?)
+        PyArray1::from_vec(py, pts).reshape([n, 2])
     }
 
     /// Rocks and trees: dicts with `kind`, `position`, `yaw`, `radius` (horizontal bounding
@@ -473,7 +471,7 @@ impl PyWorld {
 
 fn image_to_numpy(py: Python<'_>, img: image::RgbImage) -> PyResult<Bound<'_, PyArray3<u8>>> {
     let (w, h) = (img.width() as usize, img.height() as usize);
-    Ok(PyArray1::from_vec(py, img.into_raw()).reshape([h, w, 3])?)
+    PyArray1::from_vec(py, img.into_raw()).reshape([h, w, 3])
 }
 
 /// Every world of a set given by name (`verti-100`, `verti-20-s7`, a saved set directory, a
@@ -814,7 +812,7 @@ impl PySim {
         })?;
         let out = out.map_err(sim_err)?;
         let n = out.len() / 16;
-        Ok(PyArray1::from_vec(py, out).reshape([n, 16])?)
+        PyArray1::from_vec(py, out).reshape([n, 16])
     }
 
     /// Back to the start, at rest.
@@ -1413,6 +1411,9 @@ fn info_dict<'py>(
     Ok(d)
 }
 
+/// (observation, reward, terminated, truncated, info) of one step.
+type StepTuple<'py> = (Bound<'py, PyDict>, f64, bool, bool, Bound<'py, PyDict>);
+
 /// The Rust side of `verti.envs.NavigateEnv`: one environment, stepped one control period per
 /// call. Use the gymnasium wrapper rather than this class directly.
 #[pyclass(name = "EnvCore", module = "verti")]
@@ -1463,7 +1464,7 @@ impl PyEnvCore {
         &mut self,
         py: Python<'py>,
         action: PyReadonlyArray1<'py, f64>,
-    ) -> PyResult<(Bound<'py, PyDict>, f64, bool, bool, Bound<'py, PyDict>)> {
+    ) -> PyResult<StepTuple<'py>> {
         let a = action
             .as_slice()
             .map_err(|e| value_err(e.to_string()))?
