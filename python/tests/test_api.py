@@ -239,3 +239,39 @@ def test_ctrl_c_interrupts_a_long_evaluation(world):
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
     assert time.perf_counter() - t0 < 5.0
+
+
+def test_worlds_pickle_exactly(world):
+    import copy
+    import pickle
+
+    back = pickle.loads(pickle.dumps(world))
+    assert back == world and back is not world
+    assert np.array_equal(back.heights, world.heights) and back.tasks == world.tasks
+    assert copy.deepcopy(world) is world  # immutable: copies share it
+
+
+def test_long_calls_release_the_gil(world):
+    """While an evaluation runs in a thread, Python code in this thread keeps running."""
+    import threading
+    import time
+
+    done = threading.Event()
+    box = {}
+
+    def work():
+        box["results"] = verti.evaluate("pid", [world], tasks="1-10", jobs=1, max_time=60.0)
+        done.set()
+
+    t = threading.Thread(target=work)
+    t0 = time.perf_counter()
+    t.start()
+    ticks = 0
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0.001)
+    t.join()
+    elapsed = time.perf_counter() - t0
+    assert len(box["results"]) == 10
+    # with the GIL held for the whole call this thread would not tick at all
+    assert elapsed > 0.05 and ticks > 10, (elapsed, ticks)

@@ -456,6 +456,30 @@ impl PyWorld {
         })
     }
 
+    /// Pickling (multiprocessing, SubprocVecEnv): the world travels as the bytes of its files
+    /// in verti's format, which round-trips a world exactly.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>,))> {
+        let py = slf.py();
+        let w = slf.get().inner.clone();
+        let files = detached(py, move || -> Result<Vec<(String, Vec<u8>)>, String> {
+            let dir = scratch_dir();
+            let out = verti_world::format::save_world(&w, &dir)
+                .map_err(|e| e.to_string())
+                .and_then(|_| read_files(&dir));
+            let _ = std::fs::remove_dir_all(&dir);
+            out
+        })?
+        .map_err(|e| PyOSError::new_err(format!("cannot pickle the world: {e}")))?;
+        let d = PyDict::new(py);
+        for (name, bytes) in files {
+            d.set_item(name, pyo3::types::PyBytes::new(py, &bytes))?;
+        }
+        let make = py.import("verti._verti")?.getattr("_world_from_files")?;
+        Ok((make, (d,)))
+    }
+
     /// Worlds are immutable: a copy is the same world (gymnasium deep-copies make() kwargs).
     fn __copy__(slf: Bound<'_, Self>) -> Bound<'_, Self> {
         slf
@@ -467,6 +491,68 @@ impl PyWorld {
     fn __hash__(&self) -> u64 {
         Arc::as_ptr(&self.inner) as u64
     }
+}
+
+/// A fresh scratch directory for pickling worlds.
+fn scratch_dir() -> PathBuf {
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    std::env::temp_dir().join(format!(
+        "verti-world-{}-{}-{nanos}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ))
+}
+
+fn read_files(dir: &std::path::Path) -> Result<Vec<(String, Vec<u8>)>, String> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))? {
+        let path = entry.map_err(|e| e.to_string())?.path();
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .ok_or("odd file name")?
+            .to_string();
+        out.push((
+            name,
+            std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?,
+        ));
+    }
+    Ok(out)
+}
+
+/// Rebuilds a pickled world from the bytes of its files.
+#[pyfunction]
+fn _world_from_files(py: Python<'_>, files: &Bound<'_, PyDict>) -> PyResult<PyWorld> {
+    let files: Vec<(String, Vec<u8>)> = files
+        .iter()
+        .map(|(k, v)| {
+            Ok((
+                k.extract::<String>()?,
+                v.cast::<pyo3::types::PyBytes>()?.as_bytes().to_vec(),
+            ))
+        })
+        .collect::<PyResult<_>>()?;
+    let w = detached(py, move || -> Result<World, String> {
+        let dir = scratch_dir();
+        let write = || -> Result<World, String> {
+            std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+            for (name, bytes) in &files {
+                if name.contains('/') || name.contains('\\') || name.starts_with('.') {
+                    return Err(format!("bad file name `{name}` in a pickled world"));
+                }
+                std::fs::write(dir.join(name), bytes).map_err(|e| e.to_string())?;
+            }
+            verti_world::format::load_world(&dir).map_err(|e| e.to_string())
+        };
+        let out = write();
+        let _ = std::fs::remove_dir_all(&dir);
+        out
+    })?
+    .map_err(|e| value_err(format!("cannot unpickle the world: {e}")))?;
+    Ok(PyWorld { inner: Arc::new(w) })
 }
 
 fn image_to_numpy(py: Python<'_>, img: image::RgbImage) -> PyResult<Bound<'_, PyArray3<u8>>> {
@@ -1881,6 +1967,7 @@ fn verti_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyEnvCore>()?;
     m.add_class::<PyVecEnvCore>()?;
     m.add_function(wrap_pyfunction!(load_worlds, m)?)?;
+    m.add_function(wrap_pyfunction!(_world_from_files, m)?)?;
     m.add_function(wrap_pyfunction!(vehicles, m)?)?;
     m.add_function(wrap_pyfunction!(systems, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate, m)?)?;
