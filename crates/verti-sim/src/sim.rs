@@ -500,7 +500,8 @@ pub fn start_pose(
             .map(|a| 2.0 * a.wheel.unsprung_mass)
             .sum::<f64>())
         * GRAVITY;
-    let deflection = weight / spec.wheel_count() as f64 / spec.tyre.radial_stiffness;
+    let load = weight / spec.wheel_count() as f64;
+    let deflection = load / spec.tyre.radial_stiffness;
     let mut z = f64::NEG_INFINITY;
     for (lx, ly, _, k) in &rows {
         let ax = &spec.axles[*k];
@@ -509,12 +510,32 @@ pub fn start_pose(
         let (hx, hy) = (x + hub.x, y + hub.y);
         let (h, gx, gy) = hf.sample(hx, hy);
         let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
-        z = z.max(h + (ax.wheel.radius - deflection) / nz - hub.z);
+        // On soil, seat the wheel at its static Bekker sinkage instead: dropped onto the
+        // undeformed surface it would overshoot, and the plastic memory would keep the ruts of
+        // that first bounce (deep enough to high-centre a HMMWV in snow).
+        let sunk = match world.patches.at(hx, hy).surface {
+            verti_world::Surface::Deformable { soil } if world.terrain.contains(hx, hy) => {
+                static_sinkage(load * nz, ax.wheel.width, ax.wheel.radius, &soil).min(0.8 * ax.wheel.radius)
+            }
+            _ => deflection,
+        };
+        z = z.max(h + (ax.wheel.radius - sunk) / nz - hub.z);
     }
     Ok(Pose {
         position: Vec3::new(x, y, z),
         orientation,
     })
+}
+
+/// Bekker's closed-form sinkage of a rigid wheel (width b, radius r) at rest under `load`,
+/// parabolic contact arc over both halves:
+/// W = 2·b·k·√(2r)·z^(n+½)·I(n), k = K_c/b + K_φ, I(n) = √π·Γ(n+1) / (2·Γ(n+3/2)).
+pub fn static_sinkage(load: f64, b: f64, r: f64, soil: &verti_world::SoilParams) -> f64 {
+    let n = soil.bekker_n;
+    let k = soil.bekker_kc / b + soil.bekker_kphi;
+    let i = std::f64::consts::PI.sqrt() * libm::tgamma(n + 1.0) / (2.0 * libm::tgamma(n + 1.5));
+    let z = (load.max(0.0) / (2.0 * b * k * (2.0 * r).sqrt() * i)).powf(1.0 / (n + 0.5));
+    if z.is_finite() { z } else { 0.0 }
 }
 
 /// Static spring compression per axle: a rigid chassis on the axle springs (heave and pitch),
