@@ -124,7 +124,7 @@ pub struct BenchCase {
     pub terrain: String,
     pub world: String,
     pub sim_seconds: f64,
-    /// Median wall time of the runs [s].
+    /// Median wall time of the runs \[s\].
     pub wall_seconds: f64,
     /// Real-time factor of the median run: simulated seconds per wall second.
     pub real_time_factor: f64,
@@ -133,10 +133,10 @@ pub struct BenchCase {
     pub best_real_time_factor: f64,
     /// Every run's real-time factor.
     pub runs: Vec<f64>,
-    /// Internal steps per run and the median cost per internal step [µs].
+    /// Internal steps per run and the median cost per internal step \[µs\].
     pub internal_steps: u64,
     pub us_per_step: f64,
-    /// Distance travelled (start to end, horizontal) [m].
+    /// Distance travelled (start to end, horizontal) \[m\].
     pub distance: f64,
     /// Set when the run ended early with an error.
     pub error: Option<String>,
@@ -322,7 +322,7 @@ pub struct SoakReport {
     pub failures: Vec<SoakFailure>,
     /// Episodes in which the vehicle rolled over (not a failure: a physical outcome).
     pub rollovers: u64,
-    /// Largest chassis speed seen [m/s].
+    /// Largest chassis speed seen \[m/s\].
     pub max_speed: f64,
 }
 

@@ -24,8 +24,8 @@ pub fn interpolate(map: &[[f64; 2]], x: f64) -> f64 {
 
 pub const RPM_TO_RAD_S: f64 = std::f64::consts::PI / 30.0;
 
-/// Engine torque [N m] at engine speed `omega` [rad/s] and throttle in [0, 1]:
-/// `T = T0(ω)·(1 − throttle) + TF(ω)·throttle`, speed clamped to [0, max].
+/// Engine torque \[N m\] at engine speed `omega` \[rad/s\] and throttle in \[0, 1\]:
+/// `T = T0(ω)·(1 − throttle) + TF(ω)·throttle`, speed clamped to \[0, max\].
 #[inline]
 pub fn engine_torque(p: &PowertrainSpec, omega: f64, throttle: f64) -> f64 {
     let w = omega.clamp(0.0, p.max_speed_rpm * RPM_TO_RAD_S);
@@ -33,7 +33,7 @@ pub fn engine_torque(p: &PowertrainSpec, omega: f64, throttle: f64) -> f64 {
         + interpolate(&p.full_throttle, w) * throttle
 }
 
-/// The gear after applying the shift rules once at engine speed `omega` [rad/s].
+/// The gear after applying the shift rules once at engine speed `omega` \[rad/s\].
 #[inline]
 pub fn shift(p: &PowertrainSpec, gear: usize, omega: f64) -> usize {
     let rpm = omega / RPM_TO_RAD_S;

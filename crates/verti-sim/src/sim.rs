@@ -12,13 +12,18 @@
 //! chassis z axis, which is how vehicles are described here.
 //!
 //! # Integration
-//! Semi-implicit (symplectic) Euler at a fixed internal step, with two implicit parts that remove
-//! the stiff modes: (1) each wheel's suspension velocity is solved implicitly against its own
-//! spring, damper, tyre and soil stiffness (the wheel-hop mode is the stiffest in a vehicle);
-//! (2) brakes are Coulomb friction solved exactly per step, and tyre slip is a transient state
-//! whose relaxation is implicit (see [`crate::tyre`]). Every shipped vehicle is stable at its
-//! `internal_step` (2 ms full scale, 1 ms small scale), far coarser than the stiff contact
-//! modes would allow explicitly.
+//! Semi-implicit (symplectic) Euler at a fixed internal step, with implicit parts that remove
+//! the stiff modes:
+//! 1. staggered wheel update: after the chassis step, each wheel's suspension velocity is solved
+//!    implicitly against its spring, damper, stops and tyre or soil stiffness, the contact
+//!    acting on the wheel's absolute motion (the wheel-hop mode is the stiffest in a vehicle);
+//! 2. per spin group, the spin and the tyres' longitudinal forces are solved together
+//!    (linearised slip curve), then Coulomb brakes exactly;
+//! 3. the transient tyre slip relaxes implicitly (see [`crate::tyre`]).
+//!
+//! Every shipped vehicle is stable at its `internal_step`: 5 ms at full scale (Verti-Bench's
+//! step), 2 ms for the 1/6 and 1/10 vehicles. Stability at those steps is what the validation
+//! tests and the soak exercise.
 
 use crate::error::SimError;
 use crate::powertrain::{RPM_TO_RAD_S, engine_torque, shift};
@@ -31,11 +36,11 @@ use std::sync::Arc;
 use verti_core::{Quat, Vec3};
 use verti_world::{Surface, World};
 
-/// Standard gravity [m/s²] (Chrono: 9.81 along −Z).
+/// Standard gravity \[m/s²\] (Chrono: 9.81 along −Z).
 pub const GRAVITY: f64 = 9.81;
 /// Friction of obstacles (Chrono's default contact material, as Verti-Bench's obstacle boxes).
 pub const OBSTACLE_FRICTION: f64 = 0.6;
-/// Soil node spacing at full scale [m] (Verti-Bench's SCM `terrain_delta`).
+/// Soil node spacing at full scale \[m\] (Verti-Bench's SCM `terrain_delta`).
 pub const SOIL_DELTA_FULL_SCALE: f64 = 0.1;
 /// Any position farther than this from the origin, in world-scale units, is a blow-up.
 const POSITION_LIMIT: f64 = 1.0e5;
@@ -49,11 +54,11 @@ const MAX_SOIL_NODES_PER_WHEEL: usize = 4096;
 /// Driver inputs, held constant over one [`Sim::step`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Controls {
-    /// [0, 1]
+    /// \[0, 1\]
     pub throttle: f64,
-    /// [0, 1]
+    /// \[0, 1\]
     pub brake: f64,
-    /// [-1, 1]; positive turns left (counter-clockwise seen from above).
+    /// \[-1, 1\]; positive turns left (counter-clockwise seen from above).
     pub steering: f64,
 }
 
@@ -102,31 +107,31 @@ pub struct Pose {
 /// Per-wheel state and the outputs of the last internal step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct WheelState {
-    /// Spring compression from free length [m] (positive = wheel pushed up).
+    /// Spring compression from free length \[m\] (positive = wheel pushed up).
     pub compression: f64,
-    /// Its rate [m/s].
+    /// Its rate \[m/s\].
     pub compression_rate: f64,
     /// Transient longitudinal and lateral slip (see `tyre`).
     pub slip_long: f64,
     pub slip_lat: f64,
-    /// Characteristic size b = 2A/L of the last soil contact patch [m] (Bekker's K_c/b term).
+    /// Characteristic size b = 2A/L of the last soil contact patch \[m\] (Bekker's K_c/b term).
     pub soil_patch_b: f64,
     // ---- outputs of the last internal step ----
-    /// Road-wheel steer angle [rad].
+    /// Road-wheel steer angle \[rad\].
     pub steer_angle: f64,
-    /// Spin rate [rad/s].
+    /// Spin rate \[rad/s\].
     pub spin_rate: f64,
-    /// Normal load [N].
+    /// Normal load \[N\].
     pub normal_force: f64,
-    /// Longitudinal and lateral ground forces [N] in the wheel's contact frame.
+    /// Longitudinal and lateral ground forces \[N\] in the wheel's contact frame.
     pub long_force: f64,
     pub lat_force: f64,
     pub in_contact: bool,
     pub on_soil: bool,
     pub touches_obstacle: bool,
-    /// Deepest soil sinkage under the wheel [m].
+    /// Deepest soil sinkage under the wheel \[m\].
     pub sinkage: f64,
-    /// Radial tyre deflection on rigid ground or obstacles [m].
+    /// Radial tyre deflection on rigid ground or obstacles \[m\].
     pub tyre_deflection: f64,
 }
 
@@ -162,7 +167,7 @@ pub struct SimState {
     wheels: Vec<WheelState>,
     /// Spin rate per spin group.
     group_spin: Vec<f64>,
-    /// Bicycle-model steer angle [rad] (Ackermann) or last steering input (skid).
+    /// Bicycle-model steer angle \[rad\] (Ackermann) or last steering input (skid).
     steer: f64,
     gear: usize,
     engine_speed: f64,
@@ -173,11 +178,11 @@ pub struct SimState {
 }
 
 impl SimState {
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     pub fn time(&self) -> f64 {
         self.time
     }
-    /// Centre-of-mass position (world) [m].
+    /// Centre-of-mass position (world) \[m\].
     pub fn com_position(&self) -> Vec3 {
         self.position
     }
@@ -185,34 +190,34 @@ impl SimState {
     pub fn orientation(&self) -> Quat {
         self.orientation
     }
-    /// (roll, pitch, yaw) [rad], Z-Y-X convention (`Quat::to_euler`).
+    /// (roll, pitch, yaw) \[rad\], Z-Y-X convention (`Quat::to_euler`).
     pub fn euler(&self) -> (f64, f64, f64) {
         self.orientation.to_euler()
     }
-    /// Centre-of-mass velocity in the world frame [m/s].
+    /// Centre-of-mass velocity in the world frame \[m/s\].
     pub fn velocity_world(&self) -> Vec3 {
         self.velocity
     }
-    /// Centre-of-mass velocity in the body frame (x forward, y left, z up) [m/s].
+    /// Centre-of-mass velocity in the body frame (x forward, y left, z up) \[m/s\].
     pub fn velocity_body(&self) -> Vec3 {
         self.orientation.inverse_rotate(self.velocity)
     }
-    /// Angular velocity in the body frame [rad/s].
+    /// Angular velocity in the body frame \[rad/s\].
     pub fn angular_velocity_body(&self) -> Vec3 {
         self.omega
     }
-    /// Angular velocity in the world frame [rad/s].
+    /// Angular velocity in the world frame \[rad/s\].
     pub fn angular_velocity_world(&self) -> Vec3 {
         self.orientation.rotate(self.omega)
     }
-    /// Speed along the chassis x axis [m/s] (Verti-Bench's `GetSpeed` sign convention).
+    /// Speed along the chassis x axis \[m/s\] (Verti-Bench's `GetSpeed` sign convention).
     pub fn forward_speed(&self) -> f64 {
         self.velocity_body().x
     }
     pub fn wheels(&self) -> &[WheelState] {
         &self.wheels
     }
-    /// Bicycle-model steer angle [rad] (Ackermann vehicles).
+    /// Bicycle-model steer angle \[rad\] (Ackermann vehicles).
     pub fn steer_angle(&self) -> f64 {
         self.steer
     }
@@ -220,7 +225,7 @@ impl SimState {
     pub fn gear(&self) -> usize {
         self.gear
     }
-    /// Engine speed [rpm] and torque [N m] of the last internal step.
+    /// Engine speed \[rpm\] and torque \[N m\] of the last internal step.
     pub fn engine(&self) -> (f64, f64) {
         (self.engine_speed / RPM_TO_RAD_S, self.engine_torque)
     }
@@ -254,7 +259,7 @@ impl SimState {
             self.group_spin[g] = forward / r;
         }
     }
-    /// Sets the body-frame angular velocity [rad/s].
+    /// Sets the body-frame angular velocity \[rad/s\].
     pub fn set_angular_velocity_body(&mut self, omega: Vec3) {
         self.omega = omega;
     }
@@ -345,10 +350,10 @@ struct WheelModel {
     stop_damping: f64,
     brake_torque: f64,
     group: usize,
-    /// Low-speed damping of the transient slip [N s/m] (bristle damping).
+    /// Low-speed damping of the transient slip \[N s/m\] (bristle damping).
     slip_damping_long: f64,
     slip_damping_lat: f64,
-    /// Nominal static load [N]: sets the fixed stiffness of the tyre at standstill.
+    /// Nominal static load \[N\]: sets the fixed stiffness of the tyre at standstill.
     nominal_load: f64,
     /// Static compression at the start pose.
     static_compression: f64,
@@ -370,18 +375,18 @@ struct SpinGroup {
 struct LongTyre {
     active: bool,
     e_long: Vec3,
-    /// Secant slip stiffness [N per unit slip].
+    /// Secant slip stiffness \[N per unit slip\].
     stiffness: f64,
     /// κ_new = a + b·ω_new.
     a: f64,
     b: f64,
     /// 1 + h·v_ref/σ: the implicit relaxation factor of this step.
     decay: f64,
-    /// Low-speed bristle damping [N s/m].
+    /// Low-speed bristle damping \[N s/m\].
     damping: f64,
     vx: f64,
     radius: f64,
-    /// Friction left for the longitudinal force after the lateral one [N].
+    /// Friction left for the longitudinal force after the lateral one \[N\].
     limit: f64,
 }
 
@@ -399,7 +404,7 @@ struct WheelContact {
     /// Rigid part: normal load and friction scale (ground μ / tyre μ), load-weighted.
     rigid_load: f64,
     mu_scale: f64,
-    /// Deepest rigid penetration [m] (loaded-radius correction).
+    /// Deepest rigid penetration \[m\] (loaded-radius correction).
     depth: f64,
     /// Soil part.
     soil_load: f64,
@@ -515,7 +520,8 @@ pub fn start_pose(
         // that first bounce (deep enough to high-centre a HMMWV in snow).
         let sunk = match world.patches.at(hx, hy).surface {
             verti_world::Surface::Deformable { soil } if world.terrain.contains(hx, hy) => {
-                static_sinkage(load * nz, ax.wheel.width, ax.wheel.radius, &soil).min(0.8 * ax.wheel.radius)
+                static_sinkage(load * nz, ax.wheel.width, ax.wheel.radius, &soil)
+                    .min(0.8 * ax.wheel.radius)
             }
             _ => deflection,
         };
@@ -808,19 +814,19 @@ impl Sim {
     pub fn start(&self) -> Pose {
         self.start
     }
-    /// The fixed internal step [s].
+    /// The fixed internal step \[s\].
     pub fn internal_step(&self) -> f64 {
         self.step
     }
-    /// Total mass including unsprung masses and tracks [kg].
+    /// Total mass including unsprung masses and tracks \[kg\].
     pub fn total_mass(&self) -> f64 {
         self.total_mass
     }
-    /// Soil node spacing [m], when the world has soil.
+    /// Soil node spacing \[m\], when the world has soil.
     pub fn soil_spacing(&self) -> Option<f64> {
         self.soil.map(|l| l.delta)
     }
-    /// Bounding radius of the vehicle around its centre of mass (plus margin) [m].
+    /// Bounding radius of the vehicle around its centre of mass (plus margin) \[m\].
     pub fn reach(&self) -> f64 {
         self.reach
     }
@@ -944,7 +950,7 @@ impl Sim {
         h
     }
 
-    /// Total mechanical energy [J]: kinetic (chassis, unsprung masses, spinning wheels) plus
+    /// Total mechanical energy \[J\]: kinetic (chassis, unsprung masses, spinning wheels) plus
     /// gravity, suspension and tyre-spring potential. Soil deformation is dissipative and
     /// not counted.
     pub fn energy(&self, state: &SimState) -> f64 {

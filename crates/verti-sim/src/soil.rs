@@ -21,9 +21,9 @@ const CHUNK_NODES: usize = CHUNK * CHUNK;
 /// Per-node memory of one chunk (f32: millimetre-scale quantities, half the memory to copy).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Chunk {
-    /// Plastic sinkage along the undeformed normal [m].
+    /// Plastic sinkage along the undeformed normal \[m\].
     pub plastic: [f32; CHUNK_NODES],
-    /// Largest pressure carried so far [Pa].
+    /// Largest pressure carried so far \[Pa\].
     pub yield_pressure: [f32; CHUNK_NODES],
 }
 
@@ -39,7 +39,7 @@ impl Default for Chunk {
 /// Immutable layout of the node grid over a world.
 #[derive(Clone, Copy, Debug)]
 pub struct SoilLayout {
-    /// Node spacing [m].
+    /// Node spacing \[m\].
     pub delta: f64,
     /// Nodes run from index -half to +half on each axis.
     pub half: i64,
@@ -123,7 +123,7 @@ impl SoilState {
             .sum()
     }
 
-    /// Largest plastic sinkage anywhere [m].
+    /// Largest plastic sinkage anywhere \[m\].
     pub fn max_plastic_sinkage(&self) -> f64 {
         self.table
             .iter()
@@ -138,13 +138,13 @@ impl SoilState {
     }
 }
 
-/// Bekker pressure for sinkage `z` [Pa] with patch size `b` [m].
+/// Bekker pressure for sinkage `z` \[Pa\] with patch size `b` \[m\].
 #[inline]
 pub fn bekker_pressure(soil: &verti_world::SoilParams, b: f64, z: f64) -> f64 {
     (soil.bekker_kc / b + soil.bekker_kphi) * z.max(0.0).powf(soil.bekker_n)
 }
 
-/// Derivative of the Bekker pressure with respect to sinkage [Pa/m], from the pressure
+/// Derivative of the Bekker pressure with respect to sinkage \[Pa/m\], from the pressure
 /// `sigma` already computed at sinkage `z` (n·σ/z, no second `powf`).
 #[inline]
 pub fn bekker_slope(soil: &verti_world::SoilParams, sigma: f64, z: f64) -> f64 {

@@ -39,11 +39,11 @@ pub struct VehicleSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ChassisSpec {
-    /// Sprung mass [kg] (everything but the unsprung wheel assemblies).
+    /// Sprung mass \[kg\] (everything but the unsprung wheel assemblies).
     pub mass: f64,
-    /// Principal moments of inertia about the centre of mass, body axes [kg m²].
+    /// Principal moments of inertia about the centre of mass, body axes \[kg m²\].
     pub inertia: [f64; 3],
-    /// Centre of mass in the reference frame [m].
+    /// Centre of mass in the reference frame \[m\].
     pub com: [f64; 3],
     /// Collision box (centre and full size, reference frame) used for body contacts.
     pub collision_box: BoxSpec,
@@ -61,17 +61,17 @@ pub struct BoxSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AxleSpec {
-    /// Longitudinal position of the wheel centres [m].
+    /// Longitudinal position of the wheel centres \[m\].
     pub x: f64,
-    /// Distance between the left and right wheel centres [m].
+    /// Distance between the left and right wheel centres \[m\].
     pub track: f64,
-    /// Height of the wheel centres when the spring is at its free length [m].
+    /// Height of the wheel centres when the spring is at its free length \[m\].
     pub z: f64,
     #[serde(default)]
     pub steered: bool,
     #[serde(default)]
     pub driven: bool,
-    /// Maximum brake torque per wheel [N m].
+    /// Maximum brake torque per wheel \[N m\].
     pub brake_torque: f64,
     pub suspension: SuspensionSpec,
     pub wheel: WheelSpec,
@@ -80,30 +80,30 @@ pub struct AxleSpec {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SuspensionSpec {
-    /// Linear spring rate at the wheel [N/m].
+    /// Linear spring rate at the wheel \[N/m\].
     pub stiffness: f64,
-    /// Linear damping at the wheel [N s/m].
+    /// Linear damping at the wheel \[N s/m\].
     pub damping: f64,
-    /// Compression from free length at which the bump stop engages [m].
+    /// Compression from free length at which the bump stop engages \[m\].
     pub bump_travel: f64,
-    /// Extension beyond free length at which the rebound stop engages [m].
+    /// Extension beyond free length at which the rebound stop engages \[m\].
     pub rebound_travel: f64,
-    /// Stiffness of both stops [N/m] (they also carry the damping of a stiff rubber stop).
+    /// Stiffness of both stops \[N/m\] (they also carry the damping of a stiff rubber stop).
     pub stop_stiffness: f64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WheelSpec {
-    /// Unloaded tyre radius [m].
+    /// Unloaded tyre radius \[m\].
     pub radius: f64,
-    /// Tyre width [m].
+    /// Tyre width \[m\].
     pub width: f64,
-    /// Rim radius [m]: below it the tyre is bottomed out and contact gets much stiffer.
+    /// Rim radius \[m\]: below it the tyre is bottomed out and contact gets much stiffer.
     pub rim_radius: f64,
-    /// Mass that moves with the suspension (wheel, tyre, upright, spindle) [kg].
+    /// Mass that moves with the suspension (wheel, tyre, upright, spindle) \[kg\].
     pub unsprung_mass: f64,
-    /// Spin inertia of wheel and tyre [kg m²].
+    /// Spin inertia of wheel and tyre \[kg m²\].
     pub spin_inertia: f64,
 }
 
@@ -113,15 +113,15 @@ pub struct WheelSpec {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TyreSpec {
-    /// Radial stiffness [N/m].
+    /// Radial stiffness \[N/m\].
     pub radial_stiffness: f64,
-    /// Radial damping [N s/m].
+    /// Radial damping \[N s/m\].
     pub radial_damping: f64,
     /// Friction coefficient of the tyre material.
     pub friction: f64,
     /// Rolling resistance coefficient (torque = c_rr · Fz · R).
     pub rolling_resistance: f64,
-    /// Relaxation length of the transient slip [m] (about the radius).
+    /// Relaxation length of the transient slip \[m\] (about the radius).
     pub relaxation_length: f64,
     /// Longitudinal curve: initial slope, peak (value, slip), sliding (value, slip).
     pub dfx0: f64,
@@ -151,13 +151,13 @@ pub enum SteeringKind {
 #[serde(deny_unknown_fields)]
 pub struct SteeringSpec {
     pub kind: SteeringKind,
-    /// Ackermann: bicycle-model (centre) road-wheel angle at full input [deg].
+    /// Ackermann: bicycle-model (centre) road-wheel angle at full input \[deg\].
     #[serde(default)]
     pub max_angle_deg: f64,
-    /// Ackermann: slew-rate limit of the centre angle [deg/s].
+    /// Ackermann: slew-rate limit of the centre angle \[deg/s\].
     #[serde(default)]
     pub rate_deg_per_s: f64,
-    /// Skid: brake torque on the inner side at full input, per wheel [N m].
+    /// Skid: brake torque on the inner side at full input, per wheel \[N m\].
     #[serde(default)]
     pub skid_brake_torque: f64,
 }
@@ -174,7 +174,7 @@ pub enum Differential {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PowertrainSpec {
-    /// Engine or motor speed cap [rpm]; the maps are clamped to [0, max].
+    /// Engine or motor speed cap \[rpm\]; the maps are clamped to \[0, max\].
     pub max_speed_rpm: f64,
     /// Full-throttle torque map: (speed rad/s, torque N m), increasing speed.
     pub full_throttle: Vec<[f64; 2]>,
@@ -182,9 +182,9 @@ pub struct PowertrainSpec {
     pub zero_throttle: Vec<[f64; 2]>,
     /// Forward gear ratios (output speed / engine speed), increasing.
     pub gears: Vec<f64>,
-    /// Upshift above this engine speed [rpm] (ignored with one gear).
+    /// Upshift above this engine speed \[rpm\] (ignored with one gear).
     pub upshift_rpm: f64,
-    /// Downshift below this engine speed [rpm].
+    /// Downshift below this engine speed \[rpm\].
     pub downshift_rpm: f64,
     /// Final drive ratio (wheel speed / driveshaft speed).
     pub final_drive: f64,
@@ -195,7 +195,7 @@ pub struct PowertrainSpec {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TrackSpec {
-    /// Mass of one track (all shoes) [kg]; counted as sprung mass and as spin inertia of its side.
+    /// Mass of one track (all shoes) \[kg\]; counted as sprung mass and as spin inertia of its side.
     pub track_mass: f64,
 }
 

@@ -11,7 +11,7 @@ const BLOCK_CELLS: usize = 2;
 #[derive(Clone, Debug)]
 pub struct HeightBound {
     blocks: usize,
-    /// 1 / world size of one block [1/m].
+    /// 1 / world size of one block \[1/m\].
     inv_block: f64,
     half_extent: f64,
     max: Vec<f64>,
@@ -60,7 +60,7 @@ impl HeightBound {
         self.max[r * self.blocks + c]
     }
 
-    /// An upper bound of the terrain height over the box [x0, x1] x [y0, y1].
+    /// An upper bound of the terrain height over the box \[x0, x1\] x \[y0, y1\].
     pub fn max_in(&self, x0: f64, y0: f64, x1: f64, y1: f64) -> f64 {
         let (r0, c0) = self.block_of(x0, y1);
         let (r1, c1) = self.block_of(x1, y0);
