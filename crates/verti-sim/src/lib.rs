@@ -9,7 +9,7 @@
 //! * [`Sim`]: the immutable model of one vehicle on one [`verti_world::World`];
 //!   [`SimState`]: the mutable, cheap-to-clone state; [`Sim::step`] advances it.
 //! * [`start_pose`]: seats a vehicle on the terrain at a task start.
-//! * [`bench`] and [`soak`]: the speed benchmark and the random-input robustness run.
+//! * [`bench()`] and [`soak()`]: the speed benchmark and the random-input robustness run.
 //! * [`testing`]: small programmatic worlds for tests and benchmarks.
 //!
 //! ```no_run
