@@ -473,7 +473,7 @@ pub fn start_pose(
         )));
     }
     let hf = &world.terrain;
-    let (s, c) = yaw.sin_cos();
+    let (s, c) = libm::sincos(yaw);
     let comp = static_compressions(spec);
     // Least-squares plane z = a + b·x' + c·y' in heading coordinates through the wheel spots.
     let mut rows = Vec::new();
@@ -494,7 +494,7 @@ pub fn start_pose(
     let syh: f64 = rows.iter().map(|r| (r.1 - my) * (r.2 - mh)).sum();
     let slope_x = if sxx > 1e-12 { sxh / sxx } else { 0.0 };
     let slope_y = if syy > 1e-12 { syh / syy } else { 0.0 };
-    let orientation = Quat::from_euler(slope_y.atan(), -slope_x.atan(), yaw);
+    let orientation = quat_from_euler(libm::atan(slope_y), -libm::atan(slope_x), yaw);
     // Seat every tyre at its static deflection under an equal share of the weight (so a
     // vehicle set down on flat ground barely moves), and no tyre deeper than that.
     let weight = (spec.chassis.mass
@@ -540,7 +540,8 @@ pub fn static_sinkage(load: f64, b: f64, r: f64, soil: &verti_world::SoilParams)
     let n = soil.bekker_n;
     let k = soil.bekker_kc / b + soil.bekker_kphi;
     let i = std::f64::consts::PI.sqrt() * libm::tgamma(n + 1.0) / (2.0 * libm::tgamma(n + 1.5));
-    let z = (load.max(0.0) / (2.0 * b * k * (2.0 * r).sqrt() * i)).powf(1.0 / (n + 0.5));
+    let z = (load.max(0.0) / (2.0 * b * k * (2.0 * r).sqrt() * i));
+    let z = libm::pow(z, 1.0 / (n + 0.5));
     if z.is_finite() { z } else { 0.0 }
 }
 
@@ -1013,7 +1014,7 @@ impl Sim {
         let turn_radius = self.turn_radius(state.steer);
         for (m, w) in self.wheels.iter().zip(state.wheels.iter_mut()) {
             w.steer_angle = if m.steered && turn_radius.is_finite() {
-                (m.ackermann_dx / (turn_radius - m.y)).atan()
+                libm::atan(m.ackermann_dx / (turn_radius - m.y))
             } else {
                 0.0
             };
@@ -1025,7 +1026,7 @@ impl Sim {
     /// or skid-steered).
     fn turn_radius(&self, steer: f64) -> f64 {
         if self.spec.steering.kind == SteeringKind::Ackermann && steer.abs() > 1e-9 {
-            self.wheels_base_length() / steer.tan()
+            self.wheels_base_length() / libm::tan(steer)
         } else {
             f64::INFINITY
         }
@@ -1527,7 +1528,7 @@ impl Sim {
                     // beyond the map edge there are no soil nodes, and a soil grid that cannot
                     // resolve this wheel (see `soil_as_rigid`): the ground acts rigid there
                     Surface::Deformable { soil } if soil_as_rigid || !hf.contains(p.x, p.y) => {
-                        soil.friction_angle_deg.to_radians().tan()
+                        libm::tan(soil.friction_angle_deg.to_radians())
                     }
                     Surface::Deformable { .. } => {
                         soil_here = true;
@@ -1703,7 +1704,7 @@ impl Sim {
                     cached_patch = pk;
                     cached_soil = match patches[pk].surface {
                         Surface::Deformable { soil } => {
-                            Some((soil, soil.friction_angle_deg.to_radians().tan()))
+                            Some((soil, libm::tan(soil.friction_angle_deg.to_radians())))
                         }
                         Surface::Rigid { .. } => None,
                     };
@@ -1845,7 +1846,7 @@ impl Sim {
                 let mu = match patches[self.ground.patch_index(p.x, p.y)].surface {
                     Surface::Rigid { friction, .. } => friction.min(mu_body),
                     Surface::Deformable { soil } => {
-                        soil.friction_angle_deg.to_radians().tan().min(mu_body)
+                        libm::tan(soil.friction_angle_deg.to_radians()).min(mu_body)
                     }
                 };
                 if apply(*p, n, (h - p.z) * nz, mu, 1.0) {
@@ -1986,6 +1987,23 @@ fn box_penetration(local: Vec3, v_local: Vec3, d: Vec3) -> (f64, Vec3) {
         return (depth, n);
     }
     (best.1, best.2)
+}
+
+/// `Quat::from_euler` with libm's sine and cosine, so a start pose has the same bits on every
+/// platform (the engine uses libm wherever a transcendental function enters the dynamics).
+fn quat_from_euler(roll: f64, pitch: f64, yaw: f64) -> Quat {
+    let axis = |x: f64, y: f64, z: f64, angle: f64| {
+        let (s, c) = libm::sincos(0.5 * angle);
+        Quat {
+            w: c,
+            x: x * s,
+            y: y * s,
+            z: z * s,
+        }
+    };
+    axis(0.0, 0.0, 1.0, yaw)
+        .mul(axis(0.0, 1.0, 0.0, pitch))
+        .mul(axis(1.0, 0.0, 0.0, roll))
 }
 
 /// x / sqrt(1 + x²): a smooth sign without a transcendental call.

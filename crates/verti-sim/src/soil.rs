@@ -141,7 +141,7 @@ impl SoilState {
 /// Bekker pressure for sinkage `z` \[Pa\] with patch size `b` \[m\].
 #[inline]
 pub fn bekker_pressure(soil: &verti_world::SoilParams, b: f64, z: f64) -> f64 {
-    (soil.bekker_kc / b + soil.bekker_kphi) * z.max(0.0).powf(soil.bekker_n)
+    (soil.bekker_kc / b + soil.bekker_kphi) * libm::pow(z.max(0.0), soil.bekker_n)
 }
 
 /// Derivative of the Bekker pressure with respect to sinkage \[Pa/m\], from the pressure

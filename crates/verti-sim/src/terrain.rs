@@ -274,12 +274,14 @@ impl FastObstacle {
     pub fn new(o: &verti_world::Obstacle) -> FastObstacle {
         match o.shape() {
             verti_world::ObstacleShape::Rock { faces, .. } => {
-                let rot = verti_core::Quat::from_axis_angle(verti_core::Vec3::Z, o.yaw());
+                let (sy, cy) = libm::sincos(o.yaw());
                 let p = o.position();
                 let faces = faces
                     .iter()
                     .map(|f| {
-                        let n = rot.rotate(f.normal);
+                        let m = f.normal;
+                        let n =
+                            verti_core::Vec3::new(cy * m.x - sy * m.y, sy * m.x + cy * m.y, m.z);
                         (n, f.offset + n.dot(p))
                     })
                     .collect();

@@ -87,7 +87,7 @@ pub fn janosi_fraction(s: f64, contact_length: f64, janosi_k: f64) -> f64 {
     if x < 1e-6 {
         0.5 * x
     } else {
-        1.0 - (1.0 - (-x).exp()) / x
+        1.0 - (1.0 - libm::exp(-x)) / x
     }
 }
 
