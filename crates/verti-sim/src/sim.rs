@@ -540,7 +540,7 @@ pub fn static_sinkage(load: f64, b: f64, r: f64, soil: &verti_world::SoilParams)
     let n = soil.bekker_n;
     let k = soil.bekker_kc / b + soil.bekker_kphi;
     let i = std::f64::consts::PI.sqrt() * libm::tgamma(n + 1.0) / (2.0 * libm::tgamma(n + 1.5));
-    let z = (load.max(0.0) / (2.0 * b * k * (2.0 * r).sqrt() * i));
+    let z = load.max(0.0) / (2.0 * b * k * (2.0 * r).sqrt() * i);
     let z = libm::pow(z, 1.0 / (n + 0.5));
     if z.is_finite() { z } else { 0.0 }
 }
