@@ -267,3 +267,29 @@ fn a_vehicle_too_small_for_the_soil_grid_does_not_fall_through() {
         st.com_position().z
     );
 }
+
+#[test]
+fn positive_steering_turns_left_for_wheeled_and_tracked_vehicles() {
+    for name in ["hmmwv", "artcar", "truck8", "m113"] {
+        let spec = vehicles::builtin(name).unwrap();
+        let world = Arc::new(testing::flat_world(spec.scale, 0.8));
+        let sim = Sim::new(
+            &world,
+            &spec,
+            start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
+        )
+        .unwrap();
+        for steer in [0.5, -0.5] {
+            let mut st = sim.initial_state();
+            for _ in 0..200 {
+                sim.step(&mut st, Controls::new(0.6, 0.0, steer), 0.02)
+                    .unwrap();
+            }
+            let (_, _, yaw) = st.euler();
+            assert!(
+                yaw * steer.signum() > 0.2,
+                "{name}: steering {steer} gave yaw {yaw:.3} rad after 4 s"
+            );
+        }
+    }
+}
