@@ -334,6 +334,19 @@ pub struct StepReport {
     pub truncated: bool,
 }
 
+impl StepReport {
+    /// The report of an environment that was reset instead of stepped.
+    pub fn idle() -> StepReport {
+        StepReport {
+            reward: 0.0,
+            terms: RewardTerms::default(),
+            outcome: None,
+            terminated: false,
+            truncated: false,
+        }
+    }
+}
+
 /// Per-episode metrics, like the benchmark's trial results.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct EpisodeMetrics {
@@ -792,6 +805,7 @@ pub struct VecCore {
     /// Reset by the next step.
     pub pending_reset: Vec<bool>,
     pool: rayon::ThreadPool,
+    threads: usize,
 }
 
 impl VecCore {
@@ -806,19 +820,11 @@ impl VecCore {
         let envs: Vec<EnvCore> = (0..n).map(|i| template.sibling(i as u64)).collect();
         Ok(VecCore {
             obs: vec![ObsBuf::default(); n],
-            reports: vec![
-                StepReport {
-                    reward: 0.0,
-                    terms: RewardTerms::default(),
-                    outcome: None,
-                    terminated: false,
-                    truncated: false
-                };
-                n
-            ],
+            reports: vec![StepReport::idle(); n],
             pending_reset: vec![false; n],
             envs,
             pool,
+            threads,
         })
     }
 
@@ -853,13 +859,7 @@ impl VecCore {
         })?;
         self.pending_reset.iter_mut().for_each(|p| *p = false);
         for r in &mut self.reports {
-            *r = StepReport {
-                reward: 0.0,
-                terms: RewardTerms::default(),
-                outcome: None,
-                terminated: false,
-                truncated: false,
-            };
+            *r = StepReport::idle();
         }
         Ok(())
     }
@@ -885,12 +885,45 @@ impl VecCore {
                     .map_err(|e| format!("environment {i}: {e}"))
             })
             .collect::<Result<_, _>>()?;
+        let one = |(i, ((((env, buf), report), pending), action)): (
+            usize,
+            (
+                (((&mut EnvCore, &mut ObsBuf), &mut StepReport), &mut bool),
+                &EnvAction,
+            ),
+        )|
+         -> Result<(), String> {
+            if *pending {
+                env.reset(None, None)
+                    .map_err(|e| format!("environment {i}: {e}"))?;
+                *report = StepReport::idle();
+                *pending = false;
+            } else {
+                *report = env
+                    .step(*action)
+                    .map_err(|e| format!("environment {i}: {e}"))?;
+                *pending = report.terminated || report.truncated;
+            }
+            env.observe(buf)
+        };
         let (envs, obs, reports, pending) = (
             &mut self.envs,
             &mut self.obs,
             &mut self.reports,
             &mut self.pending_reset,
         );
+        if self.threads == 1 {
+            // on the calling thread: handing a batch to a one-thread pool costs a wake-up
+            // (tens of µs on a busy machine) for nothing
+            return envs
+                .iter_mut()
+                .zip(obs.iter_mut())
+                .zip(reports.iter_mut())
+                .zip(pending.iter_mut())
+                .zip(converted.iter())
+                .enumerate()
+                .try_for_each(one);
+        }
         self.pool.install(|| {
             envs.par_iter_mut()
                 .zip(obs.par_iter_mut())
@@ -898,26 +931,7 @@ impl VecCore {
                 .zip(pending.par_iter_mut())
                 .zip(converted.par_iter())
                 .enumerate()
-                .try_for_each(|(i, ((((env, buf), report), pending), action))| {
-                    if *pending {
-                        env.reset(None, None)
-                            .map_err(|e| format!("environment {i}: {e}"))?;
-                        *report = StepReport {
-                            reward: 0.0,
-                            terms: RewardTerms::default(),
-                            outcome: None,
-                            terminated: false,
-                            truncated: false,
-                        };
-                        *pending = false;
-                    } else {
-                        *report = env
-                            .step(*action)
-                            .map_err(|e| format!("environment {i}: {e}"))?;
-                        *pending = report.terminated || report.truncated;
-                    }
-                    env.observe(buf)
-                })
+                .try_for_each(one)
         })
     }
 }
