@@ -1695,6 +1695,10 @@ impl Sim {
                     continue;
                 }
                 let t = (-fe - disc.sqrt()) / ee; // lower intersection height
+                // the wheel is above every terrain height around here: no sinkage possible
+                if t >= ground_max {
+                    continue;
+                }
                 let lateral = wa + t * axle.z;
                 if lateral.abs() > m.half_width {
                     continue;
