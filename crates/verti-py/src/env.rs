@@ -795,6 +795,19 @@ impl EnvCore {
     }
 }
 
+/// One environment's share of a batch step: index, core, observation, report, pending reset
+/// and action.
+type Slot<'a> = (
+    usize,
+    (
+        (
+            ((&'a mut EnvCore, &'a mut ObsBuf), &'a mut StepReport),
+            &'a mut bool,
+        ),
+        &'a EnvAction,
+    ),
+);
+
 /// Many environments stepped together, in parallel, with next-step autoreset (gymnasium's
 /// default): an environment whose episode ended is reset by the following `step`, which
 /// ignores its action and reports reward 0 for it.
@@ -885,14 +898,7 @@ impl VecCore {
                     .map_err(|e| format!("environment {i}: {e}"))
             })
             .collect::<Result<_, _>>()?;
-        let one = |(i, ((((env, buf), report), pending), action)): (
-            usize,
-            (
-                (((&mut EnvCore, &mut ObsBuf), &mut StepReport), &mut bool),
-                &EnvAction,
-            ),
-        )|
-         -> Result<(), String> {
+        let one = |(i, ((((env, buf), report), pending), action)): Slot<'_>| -> Result<(), String> {
             if *pending {
                 env.reset(None, None)
                     .map_err(|e| format!("environment {i}: {e}"))?;
