@@ -351,9 +351,102 @@ impl fmt::Display for SoakReport {
     }
 }
 
+/// What one soak episode did.
+#[derive(Clone, Debug)]
+pub struct SoakEpisode {
+    /// Control steps taken.
+    pub steps: u64,
+    pub simulated_seconds: f64,
+    pub rolled_over: bool,
+    pub max_speed: f64,
+    /// Set when the episode ended with an error (NaN, blow-up, bad start).
+    pub error: Option<(f64, SimError)>,
+}
+
+/// One soak episode, fully determined by `episode_seed`: a random start on the map (clear of
+/// obstacles), then random throttle/brake/steering held for 0.1–2 s, `max_steps` control
+/// steps of 10 ms at most, ending early on an error or when the vehicle leaves the map.
+/// `on_step` sees the state after every step (for tracing a failure).
+pub fn soak_episode(
+    world: &Arc<World>,
+    spec: &VehicleSpec,
+    episode_seed: u64,
+    max_steps: u64,
+    mut on_step: impl FnMut(&Sim, &SimState, &Controls),
+) -> SoakEpisode {
+    let control_dt = SOAK_CONTROL_DT;
+    let mut rng = Rng::new(episode_seed);
+    let half = world.terrain.half_extent() * 0.8;
+    let mut out = SoakEpisode {
+        steps: 0,
+        simulated_seconds: 0.0,
+        rolled_over: false,
+        max_speed: 0.0,
+        error: None,
+    };
+    // random starts, redrawn (up to 100 times) while they fall inside an obstacle
+    let mut pose = Err(SimError::InvalidStart("no start drawn".into()));
+    for _ in 0..100 {
+        let (x, y, yaw) = (
+            rng.range(-half, half),
+            rng.range(-half, half),
+            rng.range(-std::f64::consts::PI, std::f64::consts::PI),
+        );
+        pose = start_pose(world, spec, x, y, yaw);
+        if pose.is_ok() {
+            break;
+        }
+    }
+    let sim = match pose.and_then(|p| Sim::new(world, spec, p)) {
+        Ok(s) => s,
+        Err(e) => {
+            out.error = Some((0.0, e));
+            out.steps = 1;
+            return out;
+        }
+    };
+    let mut state = sim.initial_state();
+    let mut controls = Controls::IDLE;
+    let mut hold = 0.0;
+    for _ in 0..max_steps {
+        if hold <= 0.0 {
+            let brake = if rng.uniform() < 0.15 {
+                rng.uniform()
+            } else {
+                0.0
+            };
+            controls = Controls {
+                throttle: rng.uniform(),
+                brake,
+                steering: rng.range(-1.0, 1.0),
+            };
+            hold = rng.range(0.1, 2.0);
+        }
+        hold -= control_dt;
+        out.steps += 1;
+        if let Err(e) = sim.step(&mut state, controls, control_dt) {
+            out.error = Some((state.time(), e));
+            break;
+        }
+        on_step(&sim, &state, &controls);
+        out.max_speed = out.max_speed.max(state.velocity_world().norm());
+        out.rolled_over |= state.is_rolled_over();
+        let p = state.com_position();
+        if !world.terrain.contains(p.x, p.y) {
+            break; // drove off the map: the next episode starts elsewhere
+        }
+    }
+    out.simulated_seconds = state.time();
+    out
+}
+
+/// Control step of the soak [s].
+pub const SOAK_CONTROL_DT: f64 = 0.01;
+
 /// Drives random inputs (held for random 0.1–2 s) through every world with every vehicle
 /// whose scale matches it (within 1 %; all vehicles when none matches), `steps` control steps
-/// of 10 ms in all, in episodes of up to 60 s from random starts. An episode that errors is
+/// of 10 ms in all, in episodes of up to 60 s from random starts ([`soak_episode`]; a failure
+/// is reproduced by calling it with the reported episode seed). An episode that errors is
 /// recorded and ended; the others are unaffected. `progress` gets the steps done so far.
 pub fn soak(
     worlds: &[Arc<World>],
@@ -362,10 +455,9 @@ pub fn soak(
     seed: u64,
     progress: impl Fn(u64),
 ) -> SoakReport {
-    let control_dt = 0.01;
-    let episode_steps = (60.0 / control_dt) as u64;
+    let episode_steps = (60.0 / SOAK_CONTROL_DT) as u64;
     let mut report = SoakReport {
-        control_dt,
+        control_dt: SOAK_CONTROL_DT,
         ..Default::default()
     };
     let t0 = Instant::now();
@@ -389,75 +481,35 @@ pub fn soak(
     }
     let mut episode = 0u64;
     let mut done = 0u64;
+    let mut last_progress = 0u64;
     while done < steps {
         let (world, spec) = &pairs[(episode % pairs.len() as u64) as usize];
-        let ep_seed = verti_core::rng::mix_seed(&[seed, episode]);
-        let mut rng = Rng::new(ep_seed);
-        let half = world.terrain.half_extent() * 0.8;
-        let (x, y, yaw) = (
-            rng.range(-half, half),
-            rng.range(-half, half),
-            rng.range(-std::f64::consts::PI, std::f64::consts::PI),
+        let episode_seed = verti_core::rng::mix_seed(&[seed, episode]);
+        let ep = soak_episode(
+            world,
+            spec,
+            episode_seed,
+            episode_steps.min(steps - done),
+            |_, _, _| {},
         );
-        let record = |report: &mut SoakReport, e: SimError, time: f64| {
+        done += ep.steps;
+        if done / 10_000 > last_progress / 10_000 {
+            progress(done);
+        }
+        last_progress = done;
+        if let Some((time, e)) = ep.error {
             report.failures.push(SoakFailure {
                 world: world.meta.name.clone(),
                 vehicle: spec.name.clone(),
                 episode,
-                episode_seed: ep_seed,
+                episode_seed,
                 time,
                 error: e.to_string(),
             });
-        };
-        let sim = match start_pose(world, spec, x, y, yaw).and_then(|p| Sim::new(world, spec, p)) {
-            Ok(s) => s,
-            Err(e) => {
-                record(&mut report, e, 0.0);
-                episode += 1;
-                done += 1;
-                continue;
-            }
-        };
-        let mut state = sim.initial_state();
-        let mut controls = Controls::IDLE;
-        let mut hold = 0.0;
-        let mut rolled = false;
-        let budget = episode_steps.min(steps - done);
-        for _ in 0..budget {
-            if hold <= 0.0 {
-                let brake = if rng.uniform() < 0.15 {
-                    rng.uniform()
-                } else {
-                    0.0
-                };
-                controls = Controls {
-                    throttle: rng.uniform(),
-                    brake,
-                    steering: rng.range(-1.0, 1.0),
-                };
-                hold = rng.range(0.1, 2.0);
-            }
-            hold -= control_dt;
-            done += 1;
-            if done.is_multiple_of(10_000) {
-                progress(done);
-            }
-            if let Err(e) = sim.step(&mut state, controls, control_dt) {
-                let t = state.time();
-                record(&mut report, e, t);
-                break;
-            }
-            report.max_speed = report.max_speed.max(state.velocity_world().norm());
-            rolled |= state.is_rolled_over();
-            if !world
-                .terrain
-                .contains(state.com_position().x, state.com_position().y)
-            {
-                break; // drove off the map: start a new episode
-            }
         }
-        report.simulated_seconds += state.time();
-        report.rollovers += u64::from(rolled);
+        report.simulated_seconds += ep.simulated_seconds;
+        report.rollovers += u64::from(ep.rolled_over);
+        report.max_speed = report.max_speed.max(ep.max_speed);
         episode += 1;
     }
     report.steps = done;

@@ -34,7 +34,10 @@ pub mod testing;
 pub mod tyre;
 pub mod vehicles;
 
-pub use bench::{BenchCase, BenchReport, BenchWorlds, SoakFailure, SoakReport, bench, soak};
+pub use bench::{
+    BenchCase, BenchReport, BenchWorlds, SoakEpisode, SoakFailure, SoakReport, bench, soak,
+    soak_episode,
+};
 pub use error::{SimError, SpecError};
 pub use sim::{ContactInfo, Controls, Pose, Sim, SimState, WheelState, start_pose};
 pub use soil::SoilState;

@@ -527,10 +527,48 @@ pub fn start_pose(
         };
         z = z.max(h + (ax.wheel.radius - sunk) / nz - hub.z);
     }
-    Ok(Pose {
+    let pose = Pose {
         position: Vec3::new(x, y, z),
         orientation,
-    })
+    };
+    // A start inside a rock or tree would be an explosion, not a drive.
+    let bx = &spec.chassis.collision_box;
+    let (c, half) = (
+        Vec3::new(bx.center[0], bx.center[1], bx.center[2]),
+        Vec3::new(bx.size[0], bx.size[1], bx.size[2]) * 0.5,
+    );
+    let mut probes: Vec<(Vec3, f64)> = Vec::new();
+    for ix in [-1.0, 0.0, 1.0] {
+        for iy in [-1.0, 0.0, 1.0] {
+            for iz in [-1.0, 0.0, 1.0] {
+                probes.push((c + Vec3::new(ix * half.x, iy * half.y, iz * half.z), 0.0));
+            }
+        }
+    }
+    for (k, ax) in spec.axles.iter().enumerate() {
+        for side in [1.0, -1.0] {
+            probes.push((
+                Vec3::new(ax.x, side * 0.5 * ax.track, ax.z + comp[k]),
+                ax.wheel.radius,
+            ));
+        }
+    }
+    for (local, clearance) in probes {
+        let p = pose.position + orientation.rotate(local);
+        for (k, o) in world.obstacles.iter().enumerate() {
+            if (p.x - o.position().x).hypot(p.y - o.position().y) > o.radius_xy() + clearance {
+                continue;
+            }
+            if o.signed_distance(p).0 < clearance {
+                return Err(SimError::InvalidStart(format!(
+                    "at ({x:.2}, {y:.2}) the vehicle would start inside obstacle {k} at ({:.2}, {:.2})",
+                    o.position().x,
+                    o.position().y
+                )));
+            }
+        }
+    }
+    Ok(pose)
 }
 
 /// Bekker's closed-form sinkage of a rigid wheel (width b, radius r) at rest under `load`,
@@ -1431,9 +1469,16 @@ impl Sim {
 
         // ---- chassis integration (semi-implicit Euler) ----
         st.velocity += accel * h;
-        st.omega += alpha_body * h;
         st.position += st.velocity * h;
-        st.orientation = integrate_orientation(st.orientation, q.rotate(st.omega), h);
+        // Rotation in momentum form: the world angular momentum takes the torque impulse, the
+        // attitude advances, and the body rates follow from the momentum in the new attitude.
+        // An explicit gyroscopic term (ω × Iω) pumps energy into a fast tumble (a vehicle
+        // thrown off a rock spinning at tens of rad/s); this form keeps |L| exact when free.
+        let inv_i = |v: Vec3| Vec3::new(v.x / i.x, v.y / i.y, v.z / i.z);
+        let momentum = q.rotate(Vec3::new(i.x * om.x, i.y * om.y, i.z * om.z)) + torque * h;
+        let omega_mid = q.rotate(inv_i(q.inverse_rotate(momentum)));
+        st.orientation = integrate_orientation(st.orientation, omega_mid, h);
+        st.omega = inv_i(st.orientation.inverse_rotate(momentum));
         st.contacts = contacts;
     }
 
