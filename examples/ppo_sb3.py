@@ -11,8 +11,8 @@ What it does:
   ``--elevation 32`` for a 32 x 32 heading-aligned elevation patch, which switches the policy
   to SB3's MultiInputPolicy with a flattening extractor);
 * SB3's own ``SubprocVecEnv``/``DummyVecEnv`` over single environments (SB3 does not take
-  gymnasium VectorEnvs); each process builds its worlds from the set name, because World
-  objects are not picklable;
+  gymnasium VectorEnvs); the worlds are generated once and passed to every environment
+  (worlds pickle exactly, so ``--subproc`` ships them to the worker processes);
 * PPO hyperparameters of the reference's shipped policies (spec §6.4: n_steps 400 per env,
   batch 200, 10 epochs, lr 5e-4, gamma 0.99, GAE 0.95, clip 0.2);
 * after training: evaluation of the deterministic policy on held-out tasks, with the
@@ -28,11 +28,11 @@ import numpy as np
 import verti  # noqa: F401  (registers verti/Navigate-v0)
 
 
-def make_env(args, tasks=None, seed=0):
+def make_env(args, worlds, tasks=None, seed=0):
     def thunk():
         env = gym.make(
             "verti/Navigate-v0",
-            world=args.worlds,
+            world=worlds,
             levels=args.levels,
             densities=args.densities,
             terrain_types=args.terrain_types,
@@ -62,8 +62,9 @@ def main():
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
+    worlds = verti.load_worlds(args.worlds)
     vec_cls = SubprocVecEnv if args.subproc else DummyVecEnv
-    train = vec_cls([make_env(args, seed=i) for i in range(args.envs)])
+    train = vec_cls([make_env(args, worlds, seed=i) for i in range(args.envs)])
     policy = "MultiInputPolicy"  # Dict observations
     model = PPO(
         policy,
@@ -87,7 +88,7 @@ def main():
 
     # held-out evaluation with the benchmark's outcomes
     args_eval = argparse.Namespace(**{**vars(args), "levels": None, "densities": None, "terrain_types": None})
-    env = make_env(args_eval, tasks=args.eval_tasks)()
+    env = make_env(args_eval, worlds, tasks=args.eval_tasks)()
     outcomes = Counter()
     for episode in range(20):
         obs, info = env.reset(seed=1000 + episode)

@@ -275,3 +275,11 @@ def test_long_calls_release_the_gil(world):
     assert len(box["results"]) == 10
     # with the GIL held for the whole call this thread would not tick at all
     assert elapsed > 0.05 and ticks > 10, (elapsed, ticks)
+
+
+def test_to_dataframe(world):
+    pd = pytest.importorskip("pandas")
+    results = verti.evaluate("pid", [world], tasks=[5, 6], jobs=1, max_time=5.0)
+    df = verti.to_dataframe(results)
+    assert isinstance(df, pd.DataFrame) and list(df.task) == [5, 6]
+    assert {"outcome", "roll_abs_mean", "pitch_raw_var", "traversal_time"} <= set(df.columns)
