@@ -52,16 +52,32 @@ fn main() {
         }
     }
     // the obstacle crop alone, as MPPI takes it (radius ~ 1.5 v T + 2 m at 0.4 m)
-    let w = Arc::new(generate_set(&SetConfig { count: 1, ..Default::default() }, &|| {}).unwrap().remove(0));
+    let w = Arc::new(
+        generate_set(
+            &SetConfig {
+                count: 1,
+                ..Default::default()
+            },
+            &|| {},
+        )
+        .unwrap()
+        .remove(0),
+    );
     let info = task_info(&w, &spec, 0, 0).unwrap();
     let obs = test_observation(&w, info.start, 3.14, info.goal, &info.global_path);
     let reach = 3.0 * 1.5 * params.step * params.horizon as f64 + 2.0;
     let size = ((2.0 * reach / 0.4).ceil() as usize) | 1;
     let t0 = std::time::Instant::now();
     for _ in 0..100 {
-        std::hint::black_box(obs.occupancy_crop(verti_bench::CropSpec { size, resolution: 0.4 }));
+        std::hint::black_box(obs.occupancy_crop(verti_bench::CropSpec {
+            size,
+            resolution: 0.4,
+        }));
     }
-    println!("occupancy crop {size}x{size}: {:.3} ms", t0.elapsed().as_secs_f64() * 10.0);
+    println!(
+        "occupancy crop {size}x{size}: {:.3} ms",
+        t0.elapsed().as_secs_f64() * 10.0
+    );
     times.sort_by(f64::total_cmp);
     let median = times[times.len() / 2];
     println!(
@@ -74,4 +90,3 @@ fn main() {
         times.len()
     );
 }
-

@@ -103,7 +103,13 @@ fn interleave<T: Copy>(count: usize, values: &[T], weights: &[f64]) -> Vec<T> {
     (0..count)
         .map(|i| {
             let deficit = |k: usize| weights[k] / total * (i + 1) as f64 - assigned[k] as f64;
-            let k = (0..values.len()).fold(0, |best, k| if deficit(k) > deficit(best) + 1e-12 { k } else { best });
+            let k = (0..values.len()).fold(0, |best, k| {
+                if deficit(k) > deficit(best) + 1e-12 {
+                    k
+                } else {
+                    best
+                }
+            });
             assigned[k] += 1;
             values[k]
         })
@@ -119,15 +125,20 @@ fn interleave<T: Copy>(count: usize, values: &[T], weights: &[f64]) -> Vec<T> {
 /// cell holds nearly the same type mix. The world order is then shuffled with the set seed.
 pub fn composition(config: &SetConfig) -> Vec<(ElevationLevel, TerrainType, ObstacleDensity)> {
     let mut rng = Rng::derive(config.seed, "composition", 0);
-    let cells: Vec<(ElevationLevel, ObstacleDensity)> =
-        ElevationLevel::ALL.iter().flat_map(|&l| ObstacleDensity::ALL.iter().map(move |&d| (l, d))).collect();
+    let cells: Vec<(ElevationLevel, ObstacleDensity)> = ElevationLevel::ALL
+        .iter()
+        .flat_map(|&l| ObstacleDensity::ALL.iter().map(move |&d| (l, d)))
+        .collect();
     let mut design = Vec::with_capacity(config.count as usize);
     for (cell, k) in cells.iter().zip(apportion(config.count, &[1.0; 9])) {
         design.extend(std::iter::repeat_n(*cell, k as usize));
     }
     let types = interleave(design.len(), &TerrainType::ALL, &[0.6, 0.3, 0.1]);
-    let mut worlds: Vec<(ElevationLevel, TerrainType, ObstacleDensity)> =
-        design.into_iter().zip(types).map(|((l, d), t)| (l, t, d)).collect();
+    let mut worlds: Vec<(ElevationLevel, TerrainType, ObstacleDensity)> = design
+        .into_iter()
+        .zip(types)
+        .map(|((l, d), t)| (l, t, d))
+        .collect();
     rng.shuffle(&mut worlds);
     worlds
 }
@@ -274,7 +285,9 @@ mod tests {
     #[test]
     fn composition_is_a_balanced_design() {
         let comp = composition(&SetConfig::default());
-        let count = |f: &dyn Fn(&(ElevationLevel, TerrainType, ObstacleDensity)) -> bool| comp.iter().filter(|c| f(c)).count();
+        let count = |f: &dyn Fn(&(ElevationLevel, TerrainType, ObstacleDensity)) -> bool| {
+            comp.iter().filter(|c| f(c)).count()
+        };
         for l in ElevationLevel::ALL {
             for d in ObstacleDensity::ALL {
                 let n = count(&|c| c.0 == l && c.2 == d);
@@ -284,12 +297,18 @@ mod tests {
             let rigid = count(&|c| c.0 == l && c.1 == TerrainType::Rigid);
             let soil = count(&|c| c.0 == l && c.1 == TerrainType::Deformable);
             let mixed = count(&|c| c.0 == l && c.1 == TerrainType::Mixed);
-            assert!((19..=21).contains(&rigid) && (9..=11).contains(&soil) && (2..=4).contains(&mixed), "{l}: {rigid} {soil} {mixed}");
+            assert!(
+                (19..=21).contains(&rigid) && (9..=11).contains(&soil) && (2..=4).contains(&mixed),
+                "{l}: {rigid} {soil} {mixed}"
+            );
         }
         assert_eq!(count(&|c| c.1 == TerrainType::Rigid), 60);
         assert_eq!(count(&|c| c.1 == TerrainType::Mixed), 10);
         // traced by hand: ties (i = 3: 0.4 vs 0.4; i = 4: 0.5 vs 0.5) go to the first category
-        assert_eq!(interleave(10, &[0u8, 1, 2], &[0.6, 0.3, 0.1]), vec![0, 1, 0, 0, 1, 0, 2, 0, 1, 0]);
+        assert_eq!(
+            interleave(10, &[0u8, 1, 2], &[0.6, 0.3, 0.1]),
+            vec![0, 1, 0, 0, 1, 0, 2, 0, 1, 0]
+        );
     }
 
     #[test]
