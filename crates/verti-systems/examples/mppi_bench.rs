@@ -64,7 +64,13 @@ fn main() {
         .remove(0),
     );
     let info = task_info(&w, &spec, 0, 0).unwrap();
-    let obs = test_observation(&w, info.start, 3.14, info.goal, &info.global_path);
+    let obs = test_observation(
+        &w,
+        info.start,
+        std::f64::consts::PI,
+        info.goal,
+        &info.global_path,
+    );
     let reach = 3.0 * 1.5 * params.step * params.horizon as f64 + 2.0;
     let size = ((2.0 * reach / 0.4).ceil() as usize) | 1;
     let t0 = std::time::Instant::now();
