@@ -142,7 +142,7 @@ def test_pid_like_policy_matches_the_benchmark(world):
     results = verti.evaluate("pid", [world], tasks=[3], jobs=1, max_time=20.0)
     env = NavigateEnv(world, task=3, control_rate=20.0, max_speed=3.0, max_time=20.0)
     obs, info = env.reset(seed=0)
-    # PID: steering = heading error to the local goal / max steer angle (0.5 rad fallback)
+    # PID: steering = heading error to the local goal / the road-wheel angle at full lock (30° here)
     while True:
         lx, ly = obs["local_goal"]
         err = np.arctan2(ly, lx)
