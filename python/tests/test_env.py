@@ -212,3 +212,12 @@ def test_sim_of_the_episode_is_a_copy(world):
     sim.step(1.0, 0.0, 0.0, dt=1.0)
     assert sim.time == pytest.approx(t + 1.0)
     assert env.sim().time == pytest.approx(t)
+
+
+def test_world_names_are_resolved_once_per_process():
+    a = NavigateEnv("verti-100:2", task=11)
+    b = NavigateEnv("verti-100:2", task=11)
+    assert a.worlds[0] is b.worlds[0] or a.worlds[0] == b.worlds[0]
+    assert a.reset(seed=0)[1]["world_name"] == "verti-100/002"
+    with pytest.raises(ValueError, match="unknown world set"):
+        NavigateEnv("no-such-set")

@@ -61,6 +61,8 @@ def test_next_step_autoreset(world):
 
 def test_vector_reset_seeds_and_errors(worlds):
     vec = NavigateVectorEnv(4, worlds)
+    with pytest.raises(ValueError, match="call reset"):
+        vec.step(np.zeros((4, 2)))
     a = vec.reset(seed=5)[1]["task"]
     b = vec.reset(seed=[5, 6, 7, 8])[1]["task"]
     assert np.array_equal(a, b)

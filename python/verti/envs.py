@@ -38,6 +38,7 @@ callable ``reward(obs, action, info) -> float`` to replace it (``info["default_r
 
 from __future__ import annotations
 
+import os
 from typing import Any, Callable, Dict, Optional, Sequence, Union
 
 import gymnasium as gym
@@ -46,7 +47,7 @@ from gymnasium import spaces
 from gymnasium.vector import VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from ._verti import OUTCOMES, EnvCore, VecEnvCore, World
+from ._verti import OUTCOMES, EnvCore, VecEnvCore, World, load_worlds
 
 ENV_ID = "verti/Navigate-v0"
 
@@ -68,6 +69,25 @@ DEFAULT_REWARD: Dict[str, float] = {
 
 WorldsArg = Union[str, World, Sequence[World]]
 RewardArg = Union[None, Dict[str, float], Callable[[Dict[str, np.ndarray], np.ndarray, Dict[str, Any]], float]]
+
+
+# Worlds by built-in name, shared by every environment of this process: worlds are immutable,
+# and generating verti-100 takes about two seconds, which gym.make_vec(..., "sync") would
+# otherwise pay once per environment. Directories are not cached (their files may change).
+_WORLD_CACHE: Dict[Any, Any] = {}
+
+
+def _resolve_worlds(world: WorldsArg, scale: float):
+    if not isinstance(world, str):
+        return world
+    base, _, index = world.rpartition(":")
+    single = bool(base) and index.isdigit()
+    if os.path.exists(base if single else world):
+        return world
+    key = (world, float(scale))
+    if key not in _WORLD_CACHE:
+        _WORLD_CACHE[key] = [World.resolve(world, scale)] if single else load_worlds(world, scale)
+    return _WORLD_CACHE[key]
 
 
 def _settings(
@@ -200,7 +220,7 @@ class NavigateEnv(gym.Env):
             occupancy=occupancy,
             reward=reward,
         )
-        self._core = EnvCore(world, vehicle, **settings)
+        self._core = EnvCore(_resolve_worlds(world, scale), vehicle, **settings)
         self._reward_fn = reward if callable(reward) else None
         if task is not None and (isinstance(task, bool) or not isinstance(task, (int, np.integer)) or task < 1):
             raise ValueError(f"task must be a task number >= 1, not {task!r}")
@@ -316,7 +336,7 @@ class NavigateVectorEnv(VectorEnv):
             occupancy=occupancy,
             reward=reward,
         )
-        self._core = VecEnvCore(int(num_envs), world, vehicle, num_threads, **settings)
+        self._core = VecEnvCore(int(num_envs), _resolve_worlds(world, scale), vehicle, num_threads, **settings)
         self._reward_fn = reward if callable(reward) else None
         self._sampler_seeded = False
         self.num_envs = int(num_envs)
