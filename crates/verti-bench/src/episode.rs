@@ -42,6 +42,10 @@ pub struct EpisodeConfig {
     pub stuck_distance: f64,
     /// Rollover threshold, degrees of |roll|.
     pub rollover_deg: f64,
+    /// A vehicle tilted further than this from upright (degrees) has capsized: the trial ends
+    /// at once as a rollover (paper rules). None of the vehicles can right itself, and without
+    /// this a tumble down a slope that lands on its wheels would end later as merely "stuck".
+    pub capsize_deg: f64,
     /// Period of the inner loop (speed controller, metrics, termination checks), seconds.
     pub inner_dt: f64,
     /// Keep a per-step log: `None` keeps nothing, `Some(s)` keeps the last `s` seconds
@@ -60,6 +64,7 @@ impl Default for EpisodeConfig {
             stuck_window: 10.0,
             stuck_distance: 1.0,
             rollover_deg: 30.0,
+            capsize_deg: 90.0,
             inner_dt: 0.01,
             log_seconds: None,
             seed: 0,
@@ -75,6 +80,7 @@ impl EpisodeConfig {
             ("stuck_window", self.stuck_window, 0.1, 3600.0),
             ("stuck_distance", self.stuck_distance, 0.0, 1000.0),
             ("rollover_deg", self.rollover_deg, 1.0, 180.0),
+            ("capsize_deg", self.capsize_deg, 1.0, 180.0),
             ("inner_dt", self.inner_dt, 1e-4, 0.1),
         ];
         for (name, v, lo, hi) in checks {
@@ -197,6 +203,8 @@ pub struct Termination {
     stuck_window: f64,
     max_time: f64,
     rollover_deg: f64,
+    /// cos of the capsize tilt: the body z axis's vertical component below this is a capsize.
+    capsize_cos: f64,
     /// Paper stuck rule: (t, x, y) sampled every 0.1 s over the last window.
     history: VecDeque<(f64, f64, f64)>,
     next_sample: f64,
@@ -218,6 +226,7 @@ impl Termination {
             stuck_window: cfg.stuck_window,
             max_time: cfg.max_time,
             rollover_deg: cfg.rollover_deg,
+            capsize_cos: cfg.capsize_deg.to_radians().cos(),
             history: VecDeque::new(),
             next_sample: 0.0,
             slow_time: 0.0,
@@ -232,14 +241,18 @@ impl Termination {
 
     /// Checks the rules after a physics step of `dt` seconds that ended at simulated time `t`
     /// with the vehicle at `pose`. Returns how the trial ends if it ends now: `Success`,
-    /// `Stuck` or `Timeout`. Whether a failure is a rollover is decided at the end by
-    /// [`Termination::classify`]. Call it after every step, in order, from the first one.
+    /// `Rollover` (capsized, paper rules), `Stuck` or `Timeout`. Whether another failure is a
+    /// rollover is decided at the end by [`Termination::classify`]. Call it after every step, in order, from the first one.
     pub fn check(&mut self, t: f64, dt: f64, pose: &Pose6) -> Option<Outcome> {
         let planar_goal = self.goal_distance(pose);
         match self.rules {
             Rules::Paper => {
                 if planar_goal < self.success_radius {
                     return Some(Outcome::Success);
+                }
+                // vertical component of the body z axis (Z-Y-X Euler angles)
+                if pose.roll.cos() * pose.pitch.cos() < self.capsize_cos {
+                    return Some(Outcome::Rollover);
                 }
                 if t + 1e-9 >= self.next_sample {
                     self.history.push_back((t, pose.x, pose.y));
