@@ -1729,6 +1729,7 @@ impl Sim {
         let mut cached_soil: Option<(verti_world::SoilParams, f64)> = None;
         for j in j0..=j1 {
             let y = j as f64 * delta;
+            let row = ground.row(y);
             for i in i0..=i1 {
                 let x = i as f64 * delta;
                 let w = Vec3::new(x - hub.x, y - hub.y, -hub.z);
@@ -1764,7 +1765,7 @@ impl Sim {
                 let Some(at) = layout.locate(i, j) else {
                     continue;
                 };
-                let (z0, gx, gy) = ground.sample(x, y);
+                let (z0, gx, gy) = row.sample(x);
                 let ca = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
                 let sinkage = ca * (z0 - t);
                 let (plastic, yield_p) = st.soil.node(at);

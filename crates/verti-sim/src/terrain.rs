@@ -221,6 +221,21 @@ impl Ground {
         }
     }
 
+    /// A sampler for points on one line of constant y: the row-dependent half of [`Ground::sample`]
+    /// is done once (the soil loop samples tens of nodes per row).
+    #[inline]
+    pub fn row(&self, y: f64) -> GroundRow<'_> {
+        let gr_raw = self.half - y * self.inv_cell;
+        let gr = gr_raw.max(0.0).min(self.max_index);
+        let r0 = (gr as usize).min(self.n - 2);
+        GroundRow {
+            ground: self,
+            base: r0 * self.n,
+            v: 1.0 - (gr - r0 as f64),
+            keep_y: if gr == gr_raw { 1.0 } else { 0.0 },
+        }
+    }
+
     /// Index into `PatchGrid::patches()` of the patch under (x, y) (edge patch off the map).
     #[inline]
     pub fn patch_index(&self, x: f64, y: f64) -> usize {
@@ -250,9 +265,58 @@ mod tests {
             let (r, c) = w.patches.index_at(x, y);
             assert_eq!(g.patch_index(x, y), r * 16 + c);
         }
+        // the row sampler is the same function
+        for _ in 0..500 {
+            let (x, y) = (rng.range(-70.0, 70.0), rng.range(-70.0, 70.0));
+            assert_eq!(g.row(y).sample(x), g.sample(x, y));
+        }
         // off the map: same height as the edge, level across the edge
         let (h, gx, _) = g.sample(80.0, 3.0);
         assert!((h - w.terrain.height_at(64.0, 3.0)).abs() < 1e-9 && gx == 0.0);
+    }
+}
+
+/// See [`Ground::row`].
+pub struct GroundRow<'a> {
+    ground: &'a Ground,
+    base: usize,
+    v: f64,
+    keep_y: f64,
+}
+
+impl GroundRow<'_> {
+    /// Exactly `Ground::sample(x, y)` for this row's y.
+    #[inline]
+    pub fn sample(&self, x: f64) -> (f64, f64, f64) {
+        let g = self.ground;
+        let gc_raw = x * g.inv_cell + g.half;
+        let gc = gc_raw.max(0.0).min(g.max_index);
+        let keep_x = if gc == gc_raw { 1.0 } else { 0.0 };
+        let c0 = (gc as usize).min(g.n - 2);
+        let u = gc - c0 as f64;
+        let v = self.v;
+        let base = self.base + c0;
+        let nw = g.heights[base];
+        let ne = g.heights[base + 1];
+        let sw = g.heights[base + g.n];
+        let se = g.heights[base + g.n + 1];
+        if u >= v {
+            let dx = se - sw;
+            let dy = ne - se;
+            (
+                sw + u * dx + v * dy,
+                dx * g.inv_cell * keep_x,
+                dy * g.inv_cell * self.keep_y,
+            )
+        } else {
+            let dy = nw - sw;
+            let dx = ne - nw;
+            (
+                sw + v * dy + u * dx,
+                dx * g.inv_cell * keep_x,
+                dy * g.inv_cell * self.keep_y,
+            )
+        }
     }
 }
 
