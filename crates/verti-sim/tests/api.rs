@@ -293,3 +293,11 @@ fn positive_steering_turns_left_for_wheeled_and_tracked_vehicles() {
         }
     }
 }
+
+#[test]
+fn model_and_state_can_cross_threads() {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Sim>();
+    assert_send_sync::<verti_sim::SimState>();
+    assert_send_sync::<VehicleSpec>();
+}
