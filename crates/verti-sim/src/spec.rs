@@ -237,6 +237,7 @@ impl VehicleSpec {
     /// Total mass: sprung + unsprung (+ tracks, which are part of the sprung mass).
     pub fn total_mass(&self) -> f64 {
         self.chassis.mass
+            + self.track.map_or(0.0, |t| 2.0 * t.track_mass)
             + self
                 .axles
                 .iter()
@@ -508,9 +509,14 @@ impl VehicleSpec {
         );
         let _ = writeln!(
             s,
-            "  mass             {:.2} kg total ({:.2} kg sprung), inertia {:?} kg m²",
+            "  mass             {:.2} kg total ({:.2} kg sprung{}), inertia {:?} kg m²",
             self.total_mass(),
-            self.chassis.mass,
+            self.chassis.mass + self.track.map_or(0.0, |t| 2.0 * t.track_mass),
+            if self.is_tracked() {
+                ", tracks included"
+            } else {
+                ""
+            },
             self.chassis.inertia
         );
         let _ = writeln!(
@@ -561,15 +567,22 @@ impl VehicleSpec {
             .iter()
             .map(|pt| pt[1])
             .fold(f64::NEG_INFINITY, f64::max);
+        let drive = if self.is_tracked() {
+            "tracks (one spin per side)".to_string()
+        } else {
+            format!(
+                "differentials axle {:?} / central {:?}",
+                p.axle_differential, p.central_differential
+            )
+        };
         let _ = writeln!(
             s,
-            "  powertrain       peak {:.1} N m, max {:.0} rpm, gears {:?}, final drive {}, differentials axle {:?} / central {:?}",
-            peak,
+            "  powertrain       peak {} N m, max {:.0} rpm, gears {:?}, final drive {}, {}",
+            significant(peak, 4),
             p.max_speed_rpm,
             p.gears,
             p.final_drive,
-            p.axle_differential,
-            p.central_differential
+            drive
         );
         let _ = writeln!(
             s,
@@ -579,4 +592,14 @@ impl VehicleSpec {
         let _ = write!(s, "  internal step    {} ms", self.internal_step * 1e3);
         s
     }
+}
+
+/// `x` with about `digits` significant digits (no exponent), for summaries of vehicles from
+/// 1/10 scale (0.06 N m motors) to trucks (1600 N m engines).
+fn significant(x: f64, digits: i32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.decimals$}")
 }
