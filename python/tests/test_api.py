@@ -283,3 +283,9 @@ def test_to_dataframe(world):
     df = verti.to_dataframe(results)
     assert isinstance(df, pd.DataFrame) and list(df.task) == [5, 6]
     assert {"outcome", "roll_abs_mean", "pitch_raw_var", "traversal_time"} <= set(df.columns)
+
+
+def test_world_hash_is_consistent_with_equality(world):
+    again = verti.World.generate(seed=0, index=1)
+    assert again == world and hash(again) == hash(world)
+    assert len({world, again, verti.World.generate(seed=0, index=2)}) == 2

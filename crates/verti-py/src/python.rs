@@ -488,8 +488,19 @@ impl PyWorld {
         slf
     }
 
+    /// Consistent with `==`: equal worlds have equal metadata.
     fn __hash__(&self) -> u64 {
-        Arc::as_ptr(&self.inner) as u64
+        use std::hash::{Hash, Hasher};
+        let m = &self.inner.meta;
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        (
+            m.name.as_str(),
+            m.index,
+            m.scale.to_bits(),
+            self.inner.terrain.size(),
+        )
+            .hash(&mut h);
+        h.finish()
     }
 }
 
