@@ -158,6 +158,9 @@ pub struct Ground {
     half: f64,
     max_index: f64,
     heights: Vec<f64>,
+    /// Per-vertex slopes (dz/dx, dz/dy) by central differences (one-sided at the border), the
+    /// vertex normals Chrono smooths its height-map meshes with and SCM uses for its nodes.
+    vertex_slopes: Vec<[f64; 2]>,
     /// Patch grid lookup: patches per side, 1 / patch size, half extent of the patch grid.
     patch_inv: f64,
     patch_half: f64,
@@ -167,12 +170,25 @@ impl Ground {
     pub fn new(world: &World) -> Ground {
         let hf = &world.terrain;
         let n = hf.size();
+        let cell = hf.cell();
+        let mut vertex_slopes = Vec::with_capacity(n * n);
+        for r in 0..n {
+            for c in 0..n {
+                let (c0, c1) = (c.saturating_sub(1), (c + 1).min(n - 1));
+                let (r0, r1) = (r.saturating_sub(1), (r + 1).min(n - 1));
+                // x grows with the column, y with decreasing row
+                let sx = (hf.vertex(r, c1) - hf.vertex(r, c0)) / ((c1 - c0) as f64 * cell);
+                let sy = (hf.vertex(r0, c) - hf.vertex(r1, c)) / ((r1 - r0) as f64 * cell);
+                vertex_slopes.push([sx, sy]);
+            }
+        }
         Ground {
             n,
-            inv_cell: 1.0 / hf.cell(),
+            inv_cell: 1.0 / cell,
             half: 0.5 * (n - 1) as f64,
             max_index: (n - 1) as f64,
             heights: hf.heights().to_vec(),
+            vertex_slopes,
             patch_inv: 1.0 / world.patches.patch_size(),
             patch_half: 0.5
                 * verti_world::surface::PATCHES_PER_SIDE as f64
@@ -197,28 +213,43 @@ impl Ground {
         let r0 = (gr as usize).min(self.n - 2);
         let u = gc - c0 as f64;
         let v = 1.0 - (gr - r0 as f64);
-        let base = r0 * self.n + c0;
-        let nw = self.heights[base];
-        let ne = self.heights[base + 1];
-        let sw = self.heights[base + self.n];
-        let se = self.heights[base + self.n + 1];
-        if u >= v {
-            let dx = se - sw;
-            let dy = ne - se;
+        self.eval(r0 * self.n + c0, u, v, keep_x, keep_y)
+    }
+
+    /// Height of the triangle under the point (the surface Chrono builds from a height map)
+    /// and slopes interpolated from the vertex slopes, so the normal varies continuously
+    /// across cell edges: a wheel rolling over a triangle edge sees no jump in its contact
+    /// normal (the seam jitter of physics_spec §5.7). On a plane both are exact.
+    /// `base` is the north-west vertex of the cell, (u, v) the position in it (east, north).
+    #[inline]
+    fn eval(&self, base: usize, u: f64, v: f64, keep_x: f64, keep_y: f64) -> (f64, f64, f64) {
+        let n = self.n;
+        let (nw, ne, sw, se) = (base, base + 1, base + n, base + n + 1);
+        let h = &self.heights;
+        let g = &self.vertex_slopes;
+        // barycentric weights of (SW, SE or NW, NE) in the cell's two triangles
+        let (height, w_sw, w_mid, w_ne, mid) = if u >= v {
+            // triangle (SW, SE, NE)
             (
-                sw + u * dx + v * dy,
-                dx * self.inv_cell * keep_x,
-                dy * self.inv_cell * keep_y,
+                h[sw] + u * (h[se] - h[sw]) + v * (h[ne] - h[se]),
+                1.0 - u,
+                u - v,
+                v,
+                se,
             )
         } else {
-            let dy = nw - sw;
-            let dx = ne - nw;
+            // triangle (SW, NE, NW)
             (
-                sw + v * dy + u * dx,
-                dx * self.inv_cell * keep_x,
-                dy * self.inv_cell * keep_y,
+                h[sw] + v * (h[nw] - h[sw]) + u * (h[ne] - h[nw]),
+                1.0 - v,
+                v - u,
+                u,
+                nw,
             )
-        }
+        };
+        let sx = w_sw * g[sw][0] + w_mid * g[mid][0] + w_ne * g[ne][0];
+        let sy = w_sw * g[sw][1] + w_mid * g[mid][1] + w_ne * g[ne][1];
+        (height, sx * keep_x, sy * keep_y)
     }
 
     /// A sampler for points on one line of constant y: the row-dependent half of [`Ground::sample`]
@@ -246,36 +277,6 @@ impl Ground {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn ground_matches_heightfield() {
-        let w = crate::testing::rough_world(1.0, 3, 16.0, crate::testing::RoughSurface::Mixed);
-        let g = Ground::new(&w);
-        let mut rng = verti_core::Rng::new(5);
-        for _ in 0..2000 {
-            let (x, y) = (rng.range(-64.0, 64.0), rng.range(-64.0, 64.0));
-            let a = g.sample(x, y);
-            let b = w.terrain.sample(x, y);
-            assert!(
-                (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9 && (a.2 - b.2).abs() < 1e-9
-            );
-            let (r, c) = w.patches.index_at(x, y);
-            assert_eq!(g.patch_index(x, y), r * 16 + c);
-        }
-        // the row sampler is the same function
-        for _ in 0..500 {
-            let (x, y) = (rng.range(-70.0, 70.0), rng.range(-70.0, 70.0));
-            assert_eq!(g.row(y).sample(x), g.sample(x, y));
-        }
-        // off the map: same height as the edge, level across the edge
-        let (h, gx, _) = g.sample(80.0, 3.0);
-        assert!((h - w.terrain.height_at(64.0, 3.0)).abs() < 1e-9 && gx == 0.0);
-    }
-}
-
 /// See [`Ground::row`].
 pub struct GroundRow<'a> {
     ground: &'a Ground,
@@ -293,30 +294,7 @@ impl GroundRow<'_> {
         let gc = gc_raw.max(0.0).min(g.max_index);
         let keep_x = if gc == gc_raw { 1.0 } else { 0.0 };
         let c0 = (gc as usize).min(g.n - 2);
-        let u = gc - c0 as f64;
-        let v = self.v;
-        let base = self.base + c0;
-        let nw = g.heights[base];
-        let ne = g.heights[base + 1];
-        let sw = g.heights[base + g.n];
-        let se = g.heights[base + g.n + 1];
-        if u >= v {
-            let dx = se - sw;
-            let dy = ne - se;
-            (
-                sw + u * dx + v * dy,
-                dx * g.inv_cell * keep_x,
-                dy * g.inv_cell * self.keep_y,
-            )
-        } else {
-            let dy = nw - sw;
-            let dx = ne - nw;
-            (
-                sw + v * dy + u * dx,
-                dx * g.inv_cell * keep_x,
-                dy * g.inv_cell * self.keep_y,
-            )
-        }
+        g.eval(self.base + c0, gc - c0 as f64, self.v, keep_x, self.keep_y)
     }
 }
 
@@ -465,6 +443,47 @@ mod fast_obstacle_tests {
                 let (b, nb) = o.signed_distance(p);
                 assert!((a - b).abs() < 1e-9 && (na - nb).norm() < 1e-9, "{a} {b}");
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ground_matches_heightfield() {
+        let w = crate::testing::rough_world(1.0, 3, 16.0, crate::testing::RoughSurface::Mixed);
+        let g = Ground::new(&w);
+        let mut rng = verti_core::Rng::new(5);
+        for _ in 0..2000 {
+            let (x, y) = (rng.range(-64.0, 64.0), rng.range(-64.0, 64.0));
+            let a = g.sample(x, y);
+            assert!((a.0 - w.terrain.height_at(x, y)).abs() < 1e-9);
+            let (r, c) = w.patches.index_at(x, y);
+            assert_eq!(g.patch_index(x, y), r * 16 + c);
+        }
+        // the row sampler is the same function
+        for _ in 0..500 {
+            let (x, y) = (rng.range(-70.0, 70.0), rng.range(-70.0, 70.0));
+            assert_eq!(g.row(y).sample(x), g.sample(x, y));
+        }
+        // slopes are continuous across cell edges: tiny steps never jump
+        for _ in 0..500 {
+            let (x, y) = (rng.range(-60.0, 60.0), rng.range(-60.0, 60.0));
+            let (a, b) = (g.sample(x, y), g.sample(x + 1e-7, y + 1e-7));
+            assert!((a.1 - b.1).abs() < 1e-4 && (a.2 - b.2).abs() < 1e-4);
+        }
+        // off the map: same height as the edge, level across the edge
+        let (h, gx, _) = g.sample(80.0, 3.0);
+        assert!((h - w.terrain.height_at(64.0, 3.0)).abs() < 1e-9 && gx == 0.0);
+        // on a plane the slopes are exact everywhere
+        let p = crate::testing::plane_world(1.0, 0.3, -0.2, 0.8);
+        let gp = Ground::new(&p);
+        for _ in 0..200 {
+            let (x, y) = (rng.range(-60.0, 60.0), rng.range(-60.0, 60.0));
+            let (_, sx, sy) = gp.sample(x, y);
+            assert!((sx - 0.3f64.tan()).abs() < 1e-9 && (sy + 0.2f64.tan()).abs() < 1e-9);
         }
     }
 }
