@@ -32,7 +32,7 @@ fn main() {
             println!("error {e}");
             break;
         }
-        if (k % 100 == 99) || (std::env::var("FINE").is_ok() && k > 100 && k < 200 && k % 5 == 0) {
+        if (k % 100 == 99) || (std::env::var("FINE").is_ok() && k > 2900) {
             let p = st.com_position();
             let (r, pi, y) = st.euler();
             let w: Vec<String> = st

@@ -1989,12 +1989,14 @@ impl Sim {
 
 /// Penetration of a point into a box, given its box-frame position `local`, its velocity
 /// relative to the box `v_local` and its depths `d` below the three face pairs (all positive).
-/// Returns the depth and the box-frame outward normal of the face it entered through: the face
-/// crossed most recently, i.e. the smallest depth / inward speed. The smallest depth alone
-/// would switch to a side face once a thin obstacle is pushed deep into a long box, and let
-/// the body slide past a tree it hit head-on.
+/// Returns the depth and the box-frame outward normal of the face it entered through: among
+/// the faces it crossed within the last 0.2 s (depth / inward speed), the most recent one.
+/// The smallest depth alone would switch to a side face once a thin obstacle is pushed deep
+/// into a long box (and let the body slide past a tree it hit head-on); without a recent
+/// crossing (resting contact, slow creep) it is the right choice and is used.
 #[inline]
 fn box_penetration(local: Vec3, v_local: Vec3, d: Vec3) -> (f64, Vec3) {
+    const RECENT: f64 = 0.2;
     let axes = [
         (
             d.x,
@@ -2015,28 +2017,26 @@ fn box_penetration(local: Vec3, v_local: Vec3, d: Vec3) -> (f64, Vec3) {
             Vec3::new(0.0, 0.0, -local.z.signum()),
         ),
     ];
-    let mut best = (f64::INFINITY, f64::INFINITY, Vec3::Z);
-    for (depth, pos, vel, n) in axes {
+    let mut recent: Option<(f64, f64, Vec3)> = None;
+    let mut shallowest = axes[0];
+    for axis in axes {
+        let (depth, pos, vel, n) = axis;
+        if depth < shallowest.0 {
+            shallowest = axis;
+        }
         // inward speed: moving toward the box centre along this axis
         let inward = -vel * pos.signum();
-        let key = if inward > 1e-3 {
-            depth / inward
-        } else {
-            f64::INFINITY
-        };
-        if key < best.0 || (key == best.0 && depth < best.1) {
-            best = (key, depth, n);
+        if inward > 0.0 && depth < RECENT * inward {
+            let since = depth / inward;
+            if recent.is_none_or(|(best, _, _)| since < best) {
+                recent = Some((since, depth, n));
+            }
         }
     }
-    if best.0.is_infinite() {
-        // resting contact: the shallowest face
-        let (depth, _, _, n) = axes
-            .into_iter()
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-            .unwrap_or(axes[2]);
-        return (depth, n);
+    match recent {
+        Some((_, depth, n)) => (depth, n),
+        None => (shallowest.0, shallowest.3),
     }
-    (best.1, best.2)
 }
 
 /// `Quat::from_euler` with libm's sine and cosine, so a start pose has the same bits on every
