@@ -12,7 +12,7 @@
 
 use rayon::prelude::*;
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, Weak};
 use verti_bench::episode::{EpisodeConfig, Outcome, Termination, pose6};
 use verti_bench::metrics::AngleStats;
 use verti_bench::observation::{CropSpec, Pose6, test_observation};
@@ -411,6 +411,9 @@ pub struct ObsBuf {
     pub occupancy: Vec<u8>,
 }
 
+/// Live simulators by (world position, pair).
+type SimCache = Arc<Mutex<HashMap<(usize, u32), Weak<Sim>>>>;
+
 /// A world, a vehicle and the benchmark's rules, stepped one control period at a time.
 #[derive(Clone)]
 pub struct EnvCore {
@@ -419,8 +422,11 @@ pub struct EnvCore {
     cfg: Arc<EnvConfig>,
     pool: Arc<Vec<(usize, u32)>>,
     rng: Rng,
-    /// Sims built so far, by (world, pair): building one plans its obstacle and soil layout.
-    sims: HashMap<(usize, u32), Arc<Sim>>,
+    /// Sims in use, by (world, pair), shared with the siblings of a vector environment.
+    /// Building one takes about 1 ms and holds about 0.5 MB (obstacle and soil layouts), so
+    /// only live ones are kept (weak references): memory stays at most one Sim per
+    /// environment, and a reset onto a task some environment is driving reuses its Sim.
+    sims: SimCache,
     ep: Option<Episode>,
     /// Rendered map of the current world and task (drawn once, copied per frame).
     base_image: Option<((usize, u32, u32), WorldImage)>,
@@ -453,7 +459,7 @@ impl EnvCore {
             cfg: Arc::new(cfg),
             pool: Arc::new(pool),
             rng: Rng::new(seed),
-            sims: HashMap::new(),
+            sims: Arc::new(Mutex::new(HashMap::new())),
             ep: None,
             base_image: None,
         })
@@ -463,7 +469,6 @@ impl EnvCore {
     pub fn sibling(&self, seed: u64) -> EnvCore {
         EnvCore {
             rng: Rng::new(seed),
-            sims: HashMap::new(),
             ep: None,
             base_image: None,
             ..self.clone()
@@ -504,10 +509,16 @@ impl EnvCore {
             .iter()
             .find(|t| t.pair == pair)
             .ok_or_else(|| format!("world {} has no pair {pair}", world.meta.name))?;
-        let sim = match self.sims.get(&(wi, pair)) {
-            Some(s) => s.clone(),
+        let cached = self
+            .sims
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .get(&(wi, pair))
+            .and_then(Weak::upgrade);
+        let sim = match cached {
+            Some(s) => s,
             None => {
-                let start = start_pose(
+                let built = start_pose(
                     world,
                     &self.spec,
                     task.start[0],
@@ -521,8 +532,12 @@ impl EnvCore {
                         world.meta.name
                     )
                 })?;
-                let s = Arc::new(start);
-                self.sims.insert((wi, pair), s.clone());
+                let s = Arc::new(built);
+                let mut sims = self.sims.lock().unwrap_or_else(|p| p.into_inner());
+                if sims.len() >= 1024 {
+                    sims.retain(|_, w| w.strong_count() > 0);
+                }
+                sims.insert((wi, pair), Arc::downgrade(&s));
                 s
             }
         };
