@@ -289,3 +289,24 @@ def test_world_hash_is_consistent_with_equality(world):
     again = verti.World.generate(seed=0, index=1)
     assert again == world and hash(again) == hash(world)
     assert len({world, again, verti.World.generate(seed=0, index=2)}) == 2
+
+
+@pytest.mark.skipif(os.name != "posix", reason="uses SIGALRM")
+def test_ctrl_c_interrupts_world_generation():
+    import signal
+    import time
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    signal.setitimer(signal.ITIMER_REAL, 0.3)
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            verti.load_worlds("verti-2000")  # about 40 s of generation on 2 cores
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    # the worlds in flight finish (about 20 ms each), the rest are skipped
+    assert time.perf_counter() - t0 < 3.0
