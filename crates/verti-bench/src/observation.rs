@@ -196,47 +196,17 @@ mod tests {
             size: 5,
             resolution: 1.0,
         };
-        let pose = Pose6 {
-            x: 0.0,
-            y: 0.0,
-            z: 0.0,
-            roll: 0.0,
-            pitch: 0.0,
-            yaw: 0.0,
-        };
-        let obs = Observation::new(
-            &world,
-            0.0,
-            pose,
-            Vec3::ZERO,
-            Vec3::ZERO,
-            0.0,
-            [10.0, 0.0],
-            &[],
-        );
-        let crop = obs.elevation_crop(spec);
-        let here = crop.get(2, 2);
         // facing east: row 0 is 2 m ahead (x = 2), row 4 is 2 m behind
+        let crop = test_observation(&world, [0.0, 0.0], 0.0, [10.0, 0.0], &[]).elevation_crop(spec);
+        let here = crop.get(2, 2);
         assert!(
             (crop.get(0, 2) - here - 0.2).abs() < 1e-9
                 && (crop.get(4, 2) - here + 0.2).abs() < 1e-9
         );
         // facing north: the robot's left is west, so column 0 is lower on this east-rising plane
-        let pose_n = Pose6 {
-            yaw: std::f64::consts::FRAC_PI_2,
-            ..pose
-        };
-        let obs = Observation::new(
-            &world,
-            0.0,
-            pose_n,
-            Vec3::ZERO,
-            Vec3::ZERO,
-            0.0,
-            [10.0, 0.0],
-            &[],
-        );
-        let crop = obs.elevation_crop(spec);
+        let north = std::f64::consts::FRAC_PI_2;
+        let crop =
+            test_observation(&world, [0.0, 0.0], north, [10.0, 0.0], &[]).elevation_crop(spec);
         let here = crop.get(2, 2);
         assert!(
             (crop.get(2, 0) - here + 0.2).abs() < 1e-9,
