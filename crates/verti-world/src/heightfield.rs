@@ -87,13 +87,21 @@ impl Heightfield {
     }
 
     /// Height and the two slopes (dz/dx, dz/dy) of the triangle under (x, y). Points off the
-    /// map read the nearest edge (the terrain extends flat-edged, like Chrono's patches).
+    /// map read the nearest edge (the terrain extends flat-edged, like Chrono's patches), and
+    /// the slope across the edge is zero there, since the height no longer changes along it.
     #[inline]
     pub fn sample(&self, x: f64, y: f64) -> (f64, f64, f64) {
-        let (gc, gr) = self.grid_coords(x, y);
+        let (gc_raw, gr_raw) = self.grid_coords(x, y);
         let m = (self.n - 1) as f64;
-        let gc = gc.clamp(0.0, m);
-        let gr = gr.clamp(0.0, m);
+        let gc = gc_raw.clamp(0.0, m);
+        let gr = gr_raw.clamp(0.0, m);
+        let (h, hx, hy) = self.sample_on_grid(gc, gr);
+        (h, if gc != gc_raw { 0.0 } else { hx }, if gr != gr_raw { 0.0 } else { hy })
+    }
+
+    /// [`Heightfield::sample`] at grid coordinates already on the map.
+    #[inline]
+    fn sample_on_grid(&self, gc: f64, gr: f64) -> (f64, f64, f64) {
         // Cell whose north-west vertex is (r0, c0); u runs east, v runs north inside it.
         let c0 = (gc.floor() as usize).min(self.n - 2);
         let r0 = (gr.floor() as usize).min(self.n - 2);
@@ -218,6 +226,10 @@ mod tests {
     fn off_map_reads_the_edge() {
         let hf = plane(5, 1.0, 1.0, 0.0, 0.0);
         assert!((hf.height_at(100.0, 0.0) - 2.0).abs() < 1e-12);
+        // level beyond the east edge, still sloped along it on the map
+        assert_eq!(hf.sample(100.0, 0.5).1, 0.0);
+        assert_eq!(hf.sample(1.5, 100.0).1, 1.0);
+        assert_eq!(hf.normal_at(100.0, 0.0), Vec3::Z);
         assert!(!hf.contains(2.5, 0.0));
         assert!(hf.contains(2.0, -2.0));
     }
