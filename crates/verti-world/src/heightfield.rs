@@ -96,7 +96,11 @@ impl Heightfield {
         let gc = gc_raw.clamp(0.0, m);
         let gr = gr_raw.clamp(0.0, m);
         let (h, hx, hy) = self.sample_on_grid(gc, gr);
-        (h, if gc != gc_raw { 0.0 } else { hx }, if gr != gr_raw { 0.0 } else { hy })
+        (
+            h,
+            if gc != gc_raw { 0.0 } else { hx },
+            if gr != gr_raw { 0.0 } else { hy },
+        )
     }
 
     /// [`Heightfield::sample`] at grid coordinates already on the map.
