@@ -1672,24 +1672,10 @@ pub struct PyVecEnvCore {
     v: VecCore,
 }
 
-fn batch_f32<'a, 'py>(
+/// Stacks per-environment rows into one (n, *shape) numpy array.
+fn batch<'a, 'py, T: numpy::Element + Copy + 'a>(
     py: Python<'py>,
-    rows: impl Iterator<Item = &'a [f32]>,
-    n: usize,
-    shape: &[usize],
-) -> PyResult<Bound<'py, PyAny>> {
-    let mut flat = Vec::with_capacity(n * shape.iter().product::<usize>());
-    for r in rows {
-        flat.extend_from_slice(r);
-    }
-    let mut dims = vec![n];
-    dims.extend_from_slice(shape);
-    Ok(PyArray1::from_vec(py, flat).reshape(dims)?.into_any())
-}
-
-fn batch_u8<'a, 'py>(
-    py: Python<'py>,
-    rows: impl Iterator<Item = &'a [u8]>,
+    rows: impl Iterator<Item = &'a [T]>,
     n: usize,
     shape: &[usize],
 ) -> PyResult<Bound<'py, PyAny>> {
@@ -1710,32 +1696,29 @@ impl PyVecEnvCore {
         let d = PyDict::new(py);
         d.set_item(
             "state",
-            batch_f32(py, o.iter().map(|b| &b.state[..]), n, &[STATE_DIM])?,
+            batch(py, o.iter().map(|b| &b.state[..]), n, &[STATE_DIM])?,
         )?;
-        d.set_item(
-            "goal",
-            batch_f32(py, o.iter().map(|b| &b.goal[..]), n, &[2])?,
-        )?;
+        d.set_item("goal", batch(py, o.iter().map(|b| &b.goal[..]), n, &[2])?)?;
         d.set_item(
             "local_goal",
-            batch_f32(py, o.iter().map(|b| &b.local_goal[..]), n, &[2])?,
+            batch(py, o.iter().map(|b| &b.local_goal[..]), n, &[2])?,
         )?;
         if let Some(c) = cfg.elevation {
             d.set_item(
                 "elevation",
-                batch_f32(py, o.iter().map(|b| &b.elevation[..]), n, &[c.size, c.size])?,
+                batch(py, o.iter().map(|b| &b.elevation[..]), n, &[c.size, c.size])?,
             )?;
         }
         if let Some(c) = cfg.semantic {
             d.set_item(
                 "semantic",
-                batch_u8(py, o.iter().map(|b| &b.semantic[..]), n, &[c.size, c.size])?,
+                batch(py, o.iter().map(|b| &b.semantic[..]), n, &[c.size, c.size])?,
             )?;
         }
         if let Some(c) = cfg.occupancy {
             d.set_item(
                 "occupancy",
-                batch_u8(py, o.iter().map(|b| &b.occupancy[..]), n, &[c.size, c.size])?,
+                batch(py, o.iter().map(|b| &b.occupancy[..]), n, &[c.size, c.size])?,
             )?;
         }
         Ok(d)
