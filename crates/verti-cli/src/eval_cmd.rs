@@ -2,7 +2,7 @@
 
 use crate::progress::bar;
 use crate::vehicle_cmd::load_vehicle;
-use crate::world_cmd::{CmdResult, ensure_parent, load_set_with_progress};
+use crate::world_cmd::{CmdResult, ScaleArg, ensure_parent, load_set_with_progress};
 use clap::Args;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -61,9 +61,8 @@ pub struct EvalArgs {
     /// default to artcar and verti4).
     #[arg(long)]
     vehicle: Option<String>,
-    /// World scale for built-in and imported sets.
-    #[arg(long, default_value = "1", value_parser = |s: &str| verti_world::scale::parse_scale(s).map_err(|e| e.to_string()))]
-    scale: f64,
+    #[command(flatten)]
+    scale: ScaleArg,
     /// Parallel trials (default: all cores). Results do not depend on it.
     #[arg(long)]
     jobs: Option<usize>,
@@ -108,9 +107,9 @@ pub fn eval(a: EvalArgs) -> CmdResult {
     let vehicle_name = a
         .vehicle
         .clone()
-        .unwrap_or_else(|| default_vehicle(a.scale).to_string());
+        .unwrap_or_else(|| default_vehicle(a.scale.scale).to_string());
     let vehicle = load_vehicle(&vehicle_name)?;
-    let set = load_set_with_progress(&a.worlds, a.scale)?;
+    let set = load_set_with_progress(&a.worlds, a.scale.scale)?;
     let worlds: Vec<Arc<World>> = set.worlds.into_iter().map(Arc::new).collect();
     let out = a
         .out
@@ -135,7 +134,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
             params: a.params.clone(),
             vehicle: vehicle.name.clone(),
             worlds: a.worlds.clone(),
-            scale: a.scale,
+            scale: a.scale.scale,
             rules: a.rules,
             seed: a.seed,
             max_time: a.max_time,
