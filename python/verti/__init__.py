@@ -16,6 +16,7 @@ FileNotFoundError/OSError or verti.SimulationError with the Rust message.
 
 from ._verti import (
     OUTCOMES,
+    FEATURES,
     SIM_STATE_FIELDS,
     STATE_FIELDS,
     EnvCore,
@@ -37,6 +38,7 @@ register_envs()
 
 __all__ = [
     "OUTCOMES",
+    "FEATURES",
     "SIM_STATE_FIELDS",
     "STATE_FIELDS",
     "EnvCore",

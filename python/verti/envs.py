@@ -107,6 +107,7 @@ def _settings(
     semantic,
     occupancy,
     reward,
+    state_features=None,
 ) -> Dict[str, Any]:
     weights = reward if isinstance(reward, dict) else None
     if reward is not None and weights is None and not callable(reward):
@@ -127,6 +128,7 @@ def _settings(
         semantic=semantic,
         occupancy=occupancy,
         reward_weights=weights,
+        state_features=None if state_features is None else list(state_features),
     )
 
 
@@ -171,6 +173,8 @@ class NavigateEnv(gym.Env):
         lookahead: local goal distance along the global path, full-scale metres.
         elevation, semantic, occupancy: heading-aligned patches (None = off).
         reward: None (default reward), a dict of its weights, or a callable.
+        state_features: names of the state vector's entries (default ``verti.STATE_FIELDS``;
+            every feature with its unit is in ``verti.FEATURES``).
         render_mode: None or ``"rgb_array"`` (top view with the task, trail and vehicle).
         render_pixels_per_cell: render resolution (4 gives 516 x 516 for a full world).
     """
@@ -198,6 +202,7 @@ class NavigateEnv(gym.Env):
         semantic=None,
         occupancy=None,
         reward: RewardArg = None,
+        state_features: Optional[Sequence[str]] = None,
         render_mode: Optional[str] = None,
         render_pixels_per_cell: int = 4,
     ):
@@ -219,6 +224,7 @@ class NavigateEnv(gym.Env):
             semantic=semantic,
             occupancy=occupancy,
             reward=reward,
+            state_features=state_features,
         )
         self._core = EnvCore(_resolve_worlds(world, scale), vehicle, **settings)
         self._reward_fn = reward if callable(reward) else None
@@ -312,6 +318,7 @@ class NavigateVectorEnv(VectorEnv):
         semantic=None,
         occupancy=None,
         reward: RewardArg = None,
+        state_features: Optional[Sequence[str]] = None,
         render_mode: Optional[str] = None,
         render_pixels_per_cell: int = 4,
     ):
@@ -335,6 +342,7 @@ class NavigateVectorEnv(VectorEnv):
             semantic=semantic,
             occupancy=occupancy,
             reward=reward,
+            state_features=state_features,
         )
         self._core = VecEnvCore(int(num_envs), _resolve_worlds(world, scale), vehicle, num_threads, **settings)
         self._reward_fn = reward if callable(reward) else None

@@ -9,17 +9,17 @@
 //! sphere (not scaled) around the goal raised 2 m (scaled) above the ground; stuck when the
 //! vehicle has been slower than 2 m/s (0.01 m per 5 ms step) for 10 s; no rollover class.
 
+use crate::features::{Feature, STEP_LOG};
 use crate::metrics::{AngleStats, SignalStats};
-use crate::observation::{Observation, Pose6};
-use crate::speed::SpeedController;
-use crate::system::{Action, MobilitySystem, TaskInfo};
+use crate::observation::Pose6;
+use crate::system::MobilitySystem;
+use crate::trial::{Trial, failed_result};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 use std::sync::Arc;
 use std::time::Instant;
-use verti_core::rng::mix_seed;
-use verti_sim::{Controls, Sim, SimState, VehicleSpec, start_pose};
-use verti_world::{TaskId, World};
+use verti_sim::VehicleSpec;
+use verti_world::World;
 
 /// Which success and failure rules apply.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -125,25 +125,25 @@ impl Outcome {
     }
 }
 
-/// One logged step.
+/// One logged inner step: the values of [`STEP_LOG`](crate::features::STEP_LOG), in order.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StepRecord {
-    pub t: f64,
-    pub x: f64,
-    pub y: f64,
-    pub z: f64,
-    pub roll: f64,
-    pub pitch: f64,
-    pub yaw: f64,
-    pub vx: f64,
-    pub vy: f64,
-    pub vz: f64,
-    pub wx: f64,
-    pub wy: f64,
-    pub wz: f64,
-    pub throttle: f64,
-    pub brake: f64,
-    pub steering: f64,
+    pub values: [f64; STEP_LOG.len()],
+}
+
+impl StepRecord {
+    /// The value of `feature`, if the log records it.
+    pub fn get(&self, feature: Feature) -> Option<f64> {
+        STEP_LOG
+            .iter()
+            .position(|f| *f == feature)
+            .map(|i| self.values[i])
+    }
+
+    /// Trial time of the step, s.
+    pub fn t(&self) -> f64 {
+        self.values[0]
+    }
 }
 
 /// Everything measured in one trial. Serialised as one JSON line of the results file.
@@ -323,244 +323,58 @@ impl Termination {
     }
 }
 
-/// The chassis pose the rules and systems see: reference-frame position and Z-Y-X Euler angles.
-pub fn pose6(sim: &Sim, state: &SimState) -> Pose6 {
-    let p = sim.reference_pose(state).position;
-    let (roll, pitch, yaw) = state.euler();
-    Pose6 {
-        x: p.x,
-        y: p.y,
-        z: p.z,
-        roll,
-        pitch,
-        yaw,
-    }
-}
-
-/// Task information for a system.
-pub fn task_info(world: &World, spec: &VehicleSpec, pair: u32, seed: u64) -> Option<TaskInfo> {
-    let task = world.tasks.iter().find(|t| t.pair == pair)?;
-    let id = TaskId {
-        world: world.meta.index,
-        pair,
-    };
-    let path = world
-        .paths
-        .get(world.tasks.iter().position(|t| t.pair == pair)?)
-        .map(|p| p.points.clone())
-        .unwrap_or_default();
-    Some(TaskInfo {
-        id,
-        start: task.start,
-        goal: task.goal,
-        global_path: path,
-        world_scale: world.meta.scale,
-        vehicle: spec.name.clone(),
-        wheelbase: spec.wheelbase(),
-        max_steer_angle: spec.steering.max_angle_deg.to_radians(),
-        seed: mix_seed(&[seed, u64::from(id.number())]),
-    })
-}
-
-/// Runs one trial. Never panics on bad system output or simulator blow-ups: those end the trial
-/// with `Outcome::Error` and a message.
+/// Runs one trial: `system.act` at the system's rate, each action held by [`Trial::step`].
+/// Never panics on bad system output or simulator blow-ups: those end the trial with
+/// `Outcome::Error` and a message. With `log`, the trial's per-step log is written into it (the
+/// last `cfg.log_seconds` of it, or all of it when that is unset).
 pub fn run_episode(
     world: &Arc<World>,
     spec: &VehicleSpec,
     pair: u32,
     system: &mut dyn MobilitySystem,
     cfg: &EpisodeConfig,
-    mut log: Option<&mut EpisodeLog>,
+    log: Option<&mut EpisodeLog>,
 ) -> TrialResult {
     let wall = Instant::now();
-    let info = task_info(world, spec, pair, cfg.seed);
-    let mut result = TrialResult {
-        task: TaskId {
-            world: world.meta.index,
-            pair,
-        }
-        .number(),
-        world: world.meta.index,
-        pair,
-        world_name: world.meta.name.clone(),
-        level: world.meta.level,
-        terrain_type: world.meta.terrain_type,
-        density: world.meta.density,
-        system: system.name().to_string(),
-        vehicle: spec.name.clone(),
-        rules: cfg.rules,
-        outcome: Outcome::Error,
-        time: 0.0,
-        traversal_time: None,
-        roll: AngleStats::default(),
-        pitch: AngleStats::default(),
-        throttle: SignalStats::default(),
-        steering: SignalStats::default(),
-        path_length: 0.0,
-        final_distance: f64::NAN,
-        final_roll: 0.0,
-        error: None,
-        wall_time: 0.0,
+    let name = system.name().to_string();
+    let cfg = match (&log, cfg.log_seconds) {
+        (Some(_), None) => EpisodeConfig {
+            log_seconds: Some(f64::INFINITY),
+            ..cfg.clone()
+        },
+        (None, Some(_)) => EpisodeConfig {
+            log_seconds: None,
+            ..cfg.clone()
+        },
+        _ => cfg.clone(),
     };
-    let fail = |mut r: TrialResult, msg: String, wall: Instant| {
-        r.outcome = Outcome::Error;
-        r.error = Some(msg);
+    let failed = |message: String| {
+        let mut r = failed_result(world, &spec.name, pair, &name, &cfg, message);
         r.wall_time = wall.elapsed().as_secs_f64();
         r
     };
-    let Some(info) = info else {
-        return fail(
-            result,
-            format!("world {} has no pair {pair}", world.meta.name),
-            wall,
-        );
+    let mut trial = match Trial::start(world, spec, pair, &cfg, &name) {
+        Ok(t) => t,
+        Err(e) => return failed(e),
     };
-    if let Err(e) = cfg.validate() {
-        return fail(result, e, wall);
-    }
-    let task = world
-        .tasks
-        .iter()
-        .find(|t| t.pair == pair)
-        .copied()
-        .expect("task_info found it");
-    let sim = match start_pose(world, spec, task.start[0], task.start[1], task.start_yaw())
-        .and_then(|p| Sim::new(world, spec, p))
-    {
-        Ok(s) => s,
-        Err(e) => return fail(result, format!("cannot start the simulation: {e}"), wall),
-    };
-    let mut state = sim.initial_state();
-    system.reset(&info);
+    system.reset(trial.info());
     let rate = system.control_rate();
     if !(rate.is_finite() && rate > 0.0 && rate <= 1000.0) {
-        return fail(
-            result,
-            format!(
-                "system {} has an invalid control rate {rate} Hz",
-                system.name()
-            ),
-            wall,
-        );
+        return failed(format!(
+            "system {name} has an invalid control rate {rate} Hz"
+        ));
     }
-    let control_period = 1.0 / rate;
-    let speed = SpeedController::default();
-    let dt = cfg.inner_dt;
-
-    let mut action = Action::HighLevel {
-        speed: 0.0,
-        steering: 0.0,
-    };
-    let mut next_control = 0.0;
-    let mut step_index: u64 = 0;
-    let mut pose = pose6(&sim, &state);
-    let mut last_xy = (pose.x, pose.y);
-    let mut rules = Termination::new(world, task.goal, cfg, &pose);
-
-    let outcome = loop {
-        let t = step_index as f64 * dt;
-        // --- system at its own rate
-        if t + 1e-9 >= next_control {
-            let v_body = state.velocity_body();
-            let obs = Observation::new(
-                world,
-                t,
-                pose,
-                v_body,
-                state.angular_velocity_body(),
-                state.forward_speed(),
-                task.goal,
-                &info.global_path,
-            );
-            action = system.act(&obs);
-            next_control += control_period;
-            let ok = match action {
-                Action::HighLevel { speed, steering } => speed.is_finite() && steering.is_finite(),
-                Action::LowLevel(c) => c.validate().is_ok(),
-            };
-            if !ok {
-                result.time = t;
-                return fail(
-                    result,
-                    format!(
-                        "system {} returned an invalid action {action:?} at t = {t:.2} s",
-                        system.name()
-                    ),
-                    wall,
-                );
-            }
+    let period = 1.0 / rate;
+    loop {
+        let action = system.act(&trial.observation());
+        if trial.step(action, period).ended.is_some() {
+            break;
         }
-        let controls: Controls = match action {
-            Action::HighLevel {
-                speed: target,
-                steering,
-            } => speed.controls(target, state.forward_speed(), steering),
-            Action::LowLevel(c) => c,
-        };
-        result.throttle.push(controls.throttle - controls.brake);
-        result.steering.push(controls.steering);
-
-        // --- physics
-        if let Err(e) = sim.step(&mut state, controls, dt) {
-            result.time = t;
-            return fail(
-                result,
-                format!("simulation failed at t = {t:.2} s: {e}"),
-                wall,
-            );
-        }
-        step_index += 1;
-        let t = step_index as f64 * dt;
-        pose = pose6(&sim, &state);
-        result.roll.push_rad(pose.roll);
-        result.pitch.push_rad(pose.pitch);
-        result.path_length += ((pose.x - last_xy.0).powi(2) + (pose.y - last_xy.1).powi(2)).sqrt();
-        last_xy = (pose.x, pose.y);
-        if let Some(log) = log.as_deref_mut() {
-            let v = state.velocity_body();
-            let w = state.angular_velocity_body();
-            log.steps.push(StepRecord {
-                t,
-                x: pose.x,
-                y: pose.y,
-                z: pose.z,
-                roll: pose.roll,
-                pitch: pose.pitch,
-                yaw: pose.yaw,
-                vx: v.x,
-                vy: v.y,
-                vz: v.z,
-                wx: w.x,
-                wy: w.y,
-                wz: w.z,
-                throttle: controls.throttle,
-                brake: controls.brake,
-                steering: controls.steering,
-            });
-            if let Some(keep) = cfg.log_seconds
-                && keep.is_finite()
-            {
-                let cut = log.steps.partition_point(|s| s.t < t - keep);
-                if cut > 1024 {
-                    log.steps.drain(..cut);
-                }
-            }
-        }
-
-        // --- termination
-        if let Some(ended) = rules.check(t, dt, &pose) {
-            break ended;
-        }
-    };
-    let t = step_index as f64 * dt;
-    result.time = t;
-    result.final_distance =
-        ((pose.x - task.goal[0]).powi(2) + (pose.y - task.goal[1]).powi(2)).sqrt();
-    result.final_roll = pose.roll.to_degrees().abs();
-    result.outcome = rules.classify(outcome, result.final_roll);
-    if result.outcome == Outcome::Success {
-        result.traversal_time = Some(t);
     }
+    if let (Some(out), Some(kept)) = (log, trial.take_log()) {
+        *out = kept;
+    }
+    let mut result = trial.finish();
     result.wall_time = wall.elapsed().as_secs_f64();
     result
 }

@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use verti_sim::VehicleSpec;
 use verti_world::{TaskId, World};
@@ -36,6 +37,9 @@ pub enum EvalError {
         line: usize,
         problem: String,
     },
+    /// The run was cancelled (`EvalSetup::cancel`); the results recorded before it are kept.
+    #[error("the evaluation was cancelled")]
+    Cancelled,
 }
 
 fn io(path: &Path) -> impl Fn(std::io::Error) -> EvalError + '_ {
@@ -190,6 +194,9 @@ pub struct EvalSetup<'a> {
     pub run: RunInfo,
     /// Optional per-step logs.
     pub step_log: Option<StepLogSink<'a>>,
+    /// Raised to stop the run: trials that finish after it is raised are not recorded (they
+    /// may have been cut short), and `evaluate` returns `EvalError::Cancelled`.
+    pub cancel: Option<&'a AtomicBool>,
 }
 
 /// Runs the selected tasks; returns all results of the run (earlier and new), sorted by task.
@@ -277,6 +284,10 @@ pub fn evaluate(
     let fresh: Result<Vec<TrialResult>, EvalError> = pool.install(|| {
         todo.par_iter()
             .map(|&(wi, pair)| {
+                let cancelled = || setup.cancel.is_some_and(|c| c.load(Ordering::SeqCst));
+                if cancelled() {
+                    return Err(EvalError::Cancelled);
+                }
                 let mut system = make_system();
                 let r = match &setup.step_log {
                     None => run_episode(
@@ -301,10 +312,16 @@ pub fn evaluate(
                             &cfg,
                             Some(&mut log),
                         );
+                        if cancelled() {
+                            return Err(EvalError::Cancelled);
+                        }
                         (sink.write)(&r, &log).map_err(EvalError::Argument)?;
                         r
                     }
                 };
+                if cancelled() {
+                    return Err(EvalError::Cancelled);
+                }
                 let mut line = serde_json::to_string(&r).expect("results serialise");
                 line.push('\n');
                 {

@@ -5,19 +5,29 @@
 //! * [`system`]: the [`MobilitySystem`] interface. Systems see an [`Observation`] and return an
 //!   [`Action`]; they never touch simulator internals.
 //! * [`observation`]: ground-truth observations with lazily computed, heading-aligned map crops.
-//! * [`episode`]: one trial of one system on one task, with the paper's success and failure
-//!   rules (or the reference code's, with `Rules::VertiBench`).
+//! * [`trial`]: [`Trial`], one vehicle on one task as one value that is stepped, cloned
+//!   (branched) and finished; the only place the inner loop (speed controller, physics,
+//!   metrics, rules) exists.
+//! * [`episode`]: the paper's success and failure rules (or the reference code's, with
+//!   `Rules::VertiBench`), the trial result, and [`run_episode`]: a system driving a `Trial`.
+//! * [`features`]: the one schema of named state features (step logs, state vectors).
+//! * [`path`]: following the global path (local goal, heading error), for systems and rewards.
 //! * [`metrics`]: per-trial metrics and their aggregation into the paper's Table I and Fig. 6.
 //! * [`eval`]: parallel, deterministic, resumable evaluation over task ranges.
 
 pub mod episode;
 pub mod eval;
+pub mod features;
 pub mod metrics;
 pub mod observation;
+pub mod path;
 pub mod report;
 pub mod speed;
 pub mod system;
+pub mod trial;
 
 pub use episode::{EpisodeConfig, Outcome, Rules, Termination, TrialResult, run_episode};
+pub use features::{Feature, FeatureSource};
 pub use observation::{Crop, CropSpec, Observation};
 pub use system::{Action, MobilitySystem, TaskInfo};
+pub use trial::{StepOutcome, Trial, pose6, task_info};

@@ -4,7 +4,9 @@
 //! Crops are computed only when a system asks for them, so a system that needs no map pays
 //! nothing for maps.
 
+use crate::features::FeatureSource;
 use verti_core::Vec3;
+use verti_sim::Controls;
 use verti_world::World;
 
 /// Size and resolution of a square crop centred on the vehicle.
@@ -53,35 +55,47 @@ pub struct Observation<'a> {
     pub angular_velocity_body: Vec3,
     /// Forward speed (body x), m/s.
     pub forward_speed: f64,
+    /// Driver inputs applied in the latest inner step (idle before the first step).
+    pub controls: Controls,
     pub goal: [f64; 2],
     pub global_path: &'a [[f64; 2]],
     /// Length scale of the world.
     pub world_scale: f64,
+    vehicle: FeatureSource,
 }
 
 impl<'a> Observation<'a> {
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn new(
+    /// An observation of `world` with the vehicle as `vehicle` describes it (inside a trial,
+    /// [`crate::Trial::observation`] makes it; tools and tests build their own).
+    pub fn new(
         world: &'a World,
-        time: f64,
-        pose: Pose6,
-        velocity_body: Vec3,
-        angular_velocity_body: Vec3,
-        forward_speed: f64,
+        vehicle: FeatureSource,
         goal: [f64; 2],
         global_path: &'a [[f64; 2]],
     ) -> Self {
         Observation {
             world,
-            time,
-            pose,
-            velocity_body,
-            angular_velocity_body,
-            forward_speed,
+            time: vehicle.time,
+            pose: vehicle.pose,
+            velocity_body: vehicle.velocity_body,
+            angular_velocity_body: vehicle.angular_velocity_body,
+            forward_speed: vehicle.forward_speed,
+            controls: vehicle.controls,
             goal,
             global_path,
             world_scale: world.meta.scale,
+            vehicle,
         }
+    }
+
+    /// The vehicle's state as named features (the schema of [`crate::features`]).
+    pub fn features(&self) -> &FeatureSource {
+        &self.vehicle
+    }
+
+    /// The world observed (ground truth).
+    pub fn world(&self) -> &'a World {
+        self.world
     }
 
     /// World (x, y) of the centre of crop cell (row, col).
@@ -180,7 +194,18 @@ pub fn test_observation<'a>(
         pitch: 0.0,
         yaw,
     };
-    Observation::new(world, 0.0, pose, Vec3::ZERO, Vec3::ZERO, 0.0, goal, path)
+    let vehicle = FeatureSource {
+        time: 0.0,
+        max_time: f64::INFINITY,
+        pose,
+        velocity_body: Vec3::ZERO,
+        angular_velocity_body: Vec3::ZERO,
+        forward_speed: 0.0,
+        steer_angle: 0.0,
+        rolled_over: false,
+        controls: Controls::IDLE,
+    };
+    Observation::new(world, vehicle, goal, path)
 }
 
 #[cfg(test)]

@@ -19,6 +19,8 @@ pub struct TaskInfo {
     /// Wheelbase and maximum road-wheel steer angle of the vehicle (for model-based systems).
     pub wheelbase: f64,
     pub max_steer_angle: f64,
+    /// The trial's time limit, simulated seconds.
+    pub max_time: f64,
     /// Seed for any randomness of the system (derived from the run seed and the task).
     pub seed: u64,
 }

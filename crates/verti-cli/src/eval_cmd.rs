@@ -140,6 +140,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
             max_time: a.max_time,
         },
         step_log: None,
+        cancel: None,
     };
     let steps_dir = out.join("steps");
     let write_log = |r: &verti_bench::TrialResult, log: &EpisodeLog| {
@@ -268,11 +269,24 @@ pub fn replay(a: ReplayArgs) -> CmdResult {
             replayed.outcome, replayed.time, recorded.outcome, recorded.time
         );
     }
-    let points: Vec<[f64; 2]> = log.steps.iter().map(|s| [s.x, s.y]).collect();
+    use verti_bench::features::Feature;
+    let value = |s: &verti_bench::episode::StepRecord, f: Feature| s.get(f).unwrap_or(f64::NAN);
+    let points: Vec<[f64; 2]> = log
+        .steps
+        .iter()
+        .map(|s| [value(s, Feature::X), value(s, Feature::Y)])
+        .collect();
     let speeds: Vec<f64> = log
         .steps
         .iter()
-        .map(|s| (s.vx * s.vx + s.vy * s.vy + s.vz * s.vz).sqrt())
+        .map(|s| {
+            let (vx, vy, vz) = (
+                value(s, Feature::Vx),
+                value(s, Feature::Vy),
+                value(s, Feature::Vz),
+            );
+            (vx * vx + vy * vy + vz * vz).sqrt()
+        })
         .collect();
     let options = verti_render::RenderOptions {
         pixels_per_cell: a.px_per_cell,

@@ -2,9 +2,11 @@
 //! default), with the vehicle state and the driver inputs. Kept in its own crate because the
 //! Parquet dependency is large and most of verti does not need it.
 //!
-//! Columns (all DOUBLE but `task`): `task` (INT32), `t` [s], `x`, `y`, `z` [m, chassis reference
-//! point, world frame], `roll`, `pitch`, `yaw` [rad], `vx`, `vy`, `vz` [m/s, body frame],
-//! `wx`, `wy`, `wz` [rad/s, body frame], `throttle`, `brake`, `steering` [driver inputs].
+//! Columns: `task` (INT32), then one DOUBLE column per feature of
+//! [`verti_bench::features::STEP_LOG`], named as the feature schema names them: `t` [s], `x`,
+//! `y`, `z` [m, chassis reference point, world frame], `roll`, `pitch`, `yaw` [rad], `vx`, `vy`,
+//! `vz` [m/s, body frame], `wx`, `wy`, `wz` [rad/s, body frame], `throttle`, `brake`,
+//! `steering` [driver inputs].
 //! File metadata (key/value): `verti.task`, `verti.world`, `verti.system`, `verti.vehicle`,
 //! `verti.outcome`.
 
@@ -20,6 +22,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use verti_bench::TrialResult;
 use verti_bench::episode::StepRecord;
+use verti_bench::features::{STEP_LOG, names_of};
 
 #[derive(Debug, thiserror::Error)]
 pub enum LogError {
@@ -32,22 +35,14 @@ pub enum LogError {
     },
 }
 
-/// The DOUBLE columns, in file order.
-pub const COLUMNS: [&str; 16] = [
-    "t", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz", "wx", "wy", "wz", "throttle",
-    "brake", "steering",
-];
-
-fn value(s: &StepRecord, column: usize) -> f64 {
-    [
-        s.t, s.x, s.y, s.z, s.roll, s.pitch, s.yaw, s.vx, s.vy, s.vz, s.wx, s.wy, s.wz, s.throttle,
-        s.brake, s.steering,
-    ][column]
+/// The names of the DOUBLE columns, in file order.
+pub fn columns() -> Vec<&'static str> {
+    names_of(&STEP_LOG)
 }
 
 fn schema() -> String {
     let mut s = String::from("message verti_step {\n  REQUIRED INT32 task;\n");
-    for c in COLUMNS {
+    for c in columns() {
         s.push_str(&format!("  REQUIRED DOUBLE {c};\n"));
     }
     s.push('}');
@@ -101,7 +96,7 @@ pub fn write_steps(
                 .write_batch(&tasks, None, None)
                 .map_err(err)?;
         } else {
-            let values: Vec<f64> = steps.iter().map(|s| value(s, column - 1)).collect();
+            let values: Vec<f64> = steps.iter().map(|s| s.values[column - 1]).collect();
             col.typed::<DoubleType>()
                 .write_batch(&values, None, None)
                 .map_err(err)?;
@@ -133,25 +128,13 @@ pub fn read_steps(path: &Path) -> Result<(u32, Vec<StepRecord>), LogError> {
     for row in reader.get_row_iter(None).map_err(err)? {
         let row = row.map_err(err)?;
         task = row.get_int(0).map_err(err)? as u32;
-        let g = |i: usize| row.get_double(i + 1).map_err(err);
-        out.push(StepRecord {
-            t: g(0)?,
-            x: g(1)?,
-            y: g(2)?,
-            z: g(3)?,
-            roll: g(4)?,
-            pitch: g(5)?,
-            yaw: g(6)?,
-            vx: g(7)?,
-            vy: g(8)?,
-            vz: g(9)?,
-            wx: g(10)?,
-            wy: g(11)?,
-            wz: g(12)?,
-            throttle: g(13)?,
-            brake: g(14)?,
-            steering: g(15)?,
-        });
+        let mut step = StepRecord {
+            values: [0.0; STEP_LOG.len()],
+        };
+        for (i, v) in step.values.iter_mut().enumerate() {
+            *v = row.get_double(i + 1).map_err(err)?;
+        }
+        out.push(step);
     }
     Ok((task, out))
 }

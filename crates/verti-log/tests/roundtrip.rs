@@ -46,7 +46,7 @@ fn logs_round_trip_exactly() {
     let (task, back) = verti_log::read_steps(&path).unwrap();
     assert_eq!(task, 25); // world 3, pair 4
     assert_eq!(back, log.steps);
-    assert!(back.first().unwrap().t <= r.time - 10.0 + 0.011);
+    assert!(back.first().unwrap().t() <= r.time - 10.0 + 0.011);
     assert!(
         !dir.join(format!("task-{:05}.parquet.partial", r.task))
             .exists()

@@ -34,7 +34,7 @@ fn main() {
     let mut times = Vec::new();
     for w in worlds.into_iter().map(Arc::new) {
         for pair in 0..10 {
-            let info = task_info(&w, &spec, pair, 0).unwrap();
+            let info = task_info(&w, &spec, pair, &Default::default()).unwrap();
             let mut m = Mppi::new(params.clone());
             m.reset(&info);
             let obs = test_observation(
@@ -63,7 +63,7 @@ fn main() {
         .unwrap()
         .remove(0),
     );
-    let info = task_info(&w, &spec, 0, 0).unwrap();
+    let info = task_info(&w, &spec, 0, &Default::default()).unwrap();
     let obs = test_observation(
         &w,
         info.start,

@@ -16,7 +16,8 @@
 
 pub mod eh;
 pub mod mppi;
-pub mod path;
+/// Path following lives in verti-bench (rewards need it too); re-exported for the systems.
+pub use verti_bench::path;
 pub mod pid;
 pub mod registry;
 

@@ -58,6 +58,7 @@ fn setup<'a>(
             max_time: 30.0,
         },
         step_log: None,
+        cancel: None,
     }
 }
 

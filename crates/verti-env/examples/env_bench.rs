@@ -2,12 +2,12 @@
 //! one environment stepped in a loop and for a `VecCore` batch, on the rigid worlds of the
 //! built-in set. The Python figures (`python -m verti.bench`) add the binding overhead.
 //!
-//!     cargo run --release -p verti-py --example env_bench [-- ENVS THREADS SECONDS]
+//!     cargo run --release -p verti-env --example env_bench [-- ENVS THREADS SECONDS]
 
 use std::sync::Arc;
 use std::time::Instant;
 use verti_core::Rng;
-use verti_py::env::{EnvConfig, EnvCore, TaskFilter, VecCore};
+use verti_env::{EnvConfig, EnvCore, TaskFilter, VecCore};
 use verti_world::TerrainType;
 use verti_world::generate::{SetConfig, generate_set};
 

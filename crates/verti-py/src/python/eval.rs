@@ -1,0 +1,411 @@
+//! Evaluation: built-in systems run in parallel in Rust, results as dicts.
+
+use super::*;
+
+/// Wraps a system so an interrupted evaluation ends its running trials at their next control
+/// step: once `cancel` is raised the system returns an invalid action, which `run_episode`
+/// ends at once (that trial is then discarded, never reported).
+pub(super) struct Cancellable<'a> {
+    inner: Box<dyn MobilitySystem>,
+    cancel: &'a AtomicBool,
+}
+
+impl MobilitySystem for Cancellable<'_> {
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+    fn control_rate(&self) -> f64 {
+        self.inner.control_rate()
+    }
+    fn reset(&mut self, task: &TaskInfo) {
+        self.inner.reset(task)
+    }
+    fn act(&mut self, obs: &Observation) -> Action {
+        if self.cancel.load(Ordering::Relaxed) {
+            return Action::HighLevel {
+                speed: f64::NAN,
+                steering: 0.0,
+            };
+        }
+        self.inner.act(obs)
+    }
+}
+
+pub(super) fn parse_rules(s: &str) -> PyResult<Rules> {
+    match s {
+        "paper" => Ok(Rules::Paper),
+        "verti-bench" | "vertibench" | "reference" => Ok(Rules::VertiBench),
+        _ => Err(value_err(format!(
+            "unknown rules `{s}`: use 'paper' or 'verti-bench'"
+        ))),
+    }
+}
+
+pub(super) fn tasks_arg(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<u32>> {
+    let Some(arg) = arg else {
+        return Ok(Vec::new());
+    };
+    if arg.is_none() {
+        return Ok(Vec::new());
+    }
+    if let Ok(s) = arg.cast::<PyString>() {
+        return parse_tasks(&s.extract::<String>()?).map_err(eval_err);
+    }
+    if let Ok(n) = arg.extract::<i64>() {
+        return u32::try_from(n)
+            .ok()
+            .filter(|n| *n >= 1)
+            .map(|n| vec![n])
+            .ok_or_else(|| value_err(format!("task number {n} must be at least 1")));
+    }
+    let list: Vec<i64> = arg.extract().map_err(|_| PyTypeError::new_err("tasks must be None (all), a task number, a list of task numbers or a range string like '1-10,15'"))?;
+    let mut out = Vec::with_capacity(list.len());
+    for n in list {
+        out.push(
+            u32::try_from(n)
+                .ok()
+                .filter(|n| *n >= 1)
+                .ok_or_else(|| value_err(format!("task number {n} must be at least 1")))?,
+        );
+    }
+    out.sort_unstable();
+    out.dedup();
+    Ok(out)
+}
+
+pub(super) fn results_to_py(py: Python<'_>, results: &[TrialResult]) -> PyResult<Vec<Py<PyAny>>> {
+    // serde is the single definition of the result fields (the same JSON as results.jsonl)
+    let loads = py.import("json")?.getattr("loads")?;
+    results
+        .iter()
+        .map(|r| {
+            let text =
+                serde_json::to_string(r).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+            Ok(loads.call1((text,))?.unbind())
+        })
+        .collect()
+}
+
+/// System parameters: None, a dict name -> number, or a list of (name, number) pairs.
+pub(super) fn params_arg(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String, f64)>> {
+    let Some(arg) = arg.filter(|a| !a.is_none()) else {
+        return Ok(Vec::new());
+    };
+    let bad = || {
+        PyTypeError::new_err(
+            "params must be a dict of parameter name -> number, e.g. {'speed': 4.0}",
+        )
+    };
+    if let Ok(d) = arg.cast::<PyDict>() {
+        return d
+            .iter()
+            .map(|(k, v)| {
+                Ok((
+                    k.extract::<String>().map_err(|_| bad())?,
+                    v.extract::<f64>().map_err(|_| bad())?,
+                ))
+            })
+            .collect();
+    }
+    arg.extract::<Vec<(String, f64)>>().map_err(|_| bad())
+}
+
+/// Runs `system` on the selected tasks, `jobs` trials at a time, and returns one dict per
+/// trial (the fields of `results.jsonl`), sorted by task. With `out`, results are also written
+/// there, resumable like `verti eval`. Ctrl-C stops it. `system` is a built-in system's name
+/// (default `pid`) or a Python object with `reset(task)` and `act(obs)` (see `pysystem`), which
+/// runs one trial at a time through the same trial code.
+#[pyfunction]
+#[pyo3(signature = (system = None, worlds = None, tasks = None, jobs = None, *, vehicle = "hmmwv", params = None, rules = "paper", max_time = 60.0, seed = 0, scale = 1.0, out = None, resume = false, force = false))]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn evaluate(
+    py: Python<'_>,
+    system: &Bound<'_, PyAny>,
+    worlds: Option<&Bound<'_, PyAny>>,
+    tasks: Option<&Bound<'_, PyAny>>,
+    jobs: Option<usize>,
+    vehicle: &str,
+    params: Option<&Bound<'_, PyAny>>,
+    rules: &str,
+    max_time: f64,
+    seed: u64,
+    scale: f64,
+    out: Option<PathBuf>,
+    resume: bool,
+    force: bool,
+) -> PyResult<Vec<Py<PyAny>>> {
+    if system.is_none() {
+        return evaluate(
+            py,
+            PyString::new(py, "pid").as_any(),
+            worlds,
+            tasks,
+            jobs,
+            vehicle,
+            params,
+            rules,
+            max_time,
+            seed,
+            scale,
+            out,
+            resume,
+            force,
+        );
+    }
+    if !system.is_instance_of::<PyString>() {
+        let setup = EvalArgs {
+            worlds,
+            tasks,
+            jobs,
+            vehicle,
+            rules,
+            max_time,
+            seed,
+            scale,
+            out,
+            resume,
+            force,
+        };
+        return evaluate_object(py, system, params, setup);
+    }
+    let system: String = system.extract()?;
+    let system = system.as_str();
+    let params = params_arg(params)?;
+    // build one system up front so unknown names and bad parameters fail before any work
+    verti_systems::create(system, &params).map_err(value_err)?;
+    let spec = vehicle_spec(vehicle)?;
+    let (worlds, worlds_name) = match worlds {
+        Some(w) if !w.is_none() => worlds_arg(py, w, scale)?,
+        _ => worlds_arg(py, PyString::new(py, "verti-100").as_any(), scale)?,
+    };
+    let selection = tasks_arg(tasks)?;
+    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    if jobs == 0 {
+        return Err(value_err("jobs must be at least 1".into()));
+    }
+    let episode = EpisodeConfig {
+        rules: parse_rules(rules)?,
+        max_time,
+        seed,
+        ..Default::default()
+    };
+    episode.validate().map_err(value_err)?;
+    let selected = select_tasks(&worlds, &selection).map_err(eval_err)?;
+    let cancel = AtomicBool::new(false);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs)
+        .build()
+        .map_err(|e| value_err(format!("cannot start {jobs} worker threads: {e}")))?;
+
+    let Some(out) = out else {
+        let results: Vec<Option<TrialResult>> = interruptible(py, &cancel, || {
+            pool.install(|| {
+                selected
+                    .par_iter()
+                    .map(|&(wi, pair)| {
+                        if cancel.load(Ordering::Relaxed) {
+                            return None;
+                        }
+                        let inner = verti_systems::create(system, &params).expect("checked above");
+                        let mut sys = Cancellable {
+                            inner,
+                            cancel: &cancel,
+                        };
+                        let r = run_episode(&worlds[wi], &spec, pair, &mut sys, &episode, None);
+                        (!cancel.load(Ordering::Relaxed)).then_some(r)
+                    })
+                    .collect()
+            })
+        })?;
+        let results: Vec<TrialResult> = results.into_iter().flatten().collect();
+        return results_to_py(py, &results);
+    };
+
+    // With a results folder: verti_bench::eval::evaluate (the CLI's resumable runner), in
+    // chunks so Ctrl-C can stop between them; every chunk resumes the same run.
+    let numbers: Vec<u32> = selected
+        .iter()
+        .map(|&(wi, pair)| {
+            TaskId {
+                world: worlds[wi].meta.index,
+                pair,
+            }
+            .number()
+        })
+        .collect();
+    let run = RunInfo {
+        system: system.to_string(),
+        params: params.clone(),
+        vehicle: spec.name.clone(),
+        worlds: worlds_name,
+        scale: worlds[0].meta.scale,
+        rules: episode.rules,
+        seed,
+        max_time,
+    };
+    let mut all = Vec::new();
+    for (k, chunk) in numbers.chunks((4 * jobs).max(16)).enumerate() {
+        let setup = EvalSetup {
+            worlds: &worlds,
+            vehicle: &spec,
+            episode: episode.clone(),
+            jobs,
+            out: out.clone(),
+            resume: resume || k > 0,
+            force: force && k == 0,
+            run: run.clone(),
+            step_log: None,
+            cancel: Some(&cancel),
+        };
+        let make = || verti_systems::create(system, &params).expect("checked above");
+        all = interruptible(py, &cancel, || {
+            verti_bench::eval::evaluate(&setup, chunk, &make, &|_| {})
+        })?
+        .map_err(eval_err)?;
+    }
+    let wanted: std::collections::BTreeSet<u32> = numbers.into_iter().collect();
+    all.retain(|r| wanted.contains(&r.task));
+    results_to_py(py, &all)
+}
+
+/// The systems that `evaluate` knows, with their parameters.
+#[pyfunction]
+pub(super) fn systems<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+    let out = PyList::empty(py);
+    for s in verti_systems::list() {
+        let d = PyDict::new(py);
+        d.set_item("name", s.name)?;
+        d.set_item("summary", s.summary)?;
+        let params = PyList::empty(py);
+        for p in s.params {
+            let pd = PyDict::new(py);
+            pd.set_item("name", p.name)?;
+            pd.set_item("default", p.default)?;
+            pd.set_item("min", p.min)?;
+            pd.set_item("max", p.max)?;
+            pd.set_item("doc", p.doc)?;
+            params.append(pd)?;
+        }
+        d.set_item("params", params)?;
+        out.append(d)?;
+    }
+    Ok(out)
+}
+
+/// The settings of `evaluate` that do not depend on the kind of system.
+pub(super) struct EvalArgs<'a, 'py> {
+    worlds: Option<&'a Bound<'py, PyAny>>,
+    tasks: Option<&'a Bound<'py, PyAny>>,
+    jobs: Option<usize>,
+    vehicle: &'a str,
+    rules: &'a str,
+    max_time: f64,
+    seed: u64,
+    scale: f64,
+    out: Option<PathBuf>,
+    resume: bool,
+    force: bool,
+}
+
+/// `evaluate` with a Python object as the system: one trial at a time (the object is not
+/// shared between threads), through `run_episode` and, with `out`, the resumable runner.
+fn evaluate_object(
+    py: Python<'_>,
+    object: &Bound<'_, PyAny>,
+    params: Option<&Bound<'_, PyAny>>,
+    a: EvalArgs<'_, '_>,
+) -> PyResult<Vec<Py<PyAny>>> {
+    if params.is_some_and(|p| !p.is_none()) {
+        return Err(value_err(
+            "params apply to built-in systems; a Python system takes its settings itself".into(),
+        ));
+    }
+    if a.jobs.is_some_and(|j| j != 1) {
+        return Err(value_err(
+            "a Python system runs one trial at a time: leave jobs unset or pass jobs=1".into(),
+        ));
+    }
+    let sys_spec = PySystemSpec::of(object)?;
+    let spec = vehicle_spec(a.vehicle)?;
+    let (worlds, worlds_name) = match a.worlds {
+        Some(w) if !w.is_none() => worlds_arg(py, w, a.scale)?,
+        _ => worlds_arg(py, PyString::new(py, "verti-100").as_any(), a.scale)?,
+    };
+    let selection = tasks_arg(a.tasks)?;
+    let episode = EpisodeConfig {
+        rules: parse_rules(a.rules)?,
+        max_time: a.max_time,
+        seed: a.seed,
+        ..Default::default()
+    };
+    episode.validate().map_err(value_err)?;
+    let selected = select_tasks(&worlds, &selection).map_err(eval_err)?;
+    let raised: RaisedError = Arc::new(std::sync::Mutex::new(None));
+    let cancel = Arc::new(AtomicBool::new(false));
+    let object: Py<PyAny> = object.clone().unbind();
+    let make = || -> Box<dyn MobilitySystem> {
+        let obj = Python::attach(|py| object.clone_ref(py));
+        Box::new(PySystem::new(
+            obj,
+            sys_spec.clone(),
+            raised.clone(),
+            cancel.clone(),
+        ))
+    };
+    let take_raised = || raised.lock().unwrap_or_else(|p| p.into_inner()).take();
+
+    let Some(out) = a.out else {
+        let results: Vec<TrialResult> = interruptible(py, &cancel, || {
+            let mut done = Vec::new();
+            for &(wi, pair) in &selected {
+                let mut system = make();
+                let r = run_episode(&worlds[wi], &spec, pair, system.as_mut(), &episode, None);
+                if cancel.load(Ordering::SeqCst) {
+                    break;
+                }
+                done.push(r);
+            }
+            done
+        })?;
+        if let Some(e) = take_raised() {
+            return Err(e);
+        }
+        return results_to_py(py, &results);
+    };
+    let run = RunInfo {
+        system: sys_spec.name.clone(),
+        params: vec![],
+        vehicle: spec.name.clone(),
+        worlds: worlds_name,
+        scale: worlds[0].meta.scale,
+        rules: episode.rules,
+        seed: a.seed,
+        max_time: a.max_time,
+    };
+    let setup = EvalSetup {
+        worlds: &worlds,
+        vehicle: &spec,
+        episode,
+        jobs: 1,
+        out,
+        resume: a.resume,
+        force: a.force,
+        run,
+        step_log: None,
+        cancel: Some(&cancel),
+    };
+    let numbers: Vec<u32> = selected
+        .iter()
+        .map(|&(wi, pair)| worlds[wi].task_id(pair).number())
+        .collect();
+    let result = interruptible(py, &cancel, || {
+        verti_bench::eval::evaluate(&setup, &numbers, &make, &|_| {})
+    })?;
+    if let Some(e) = take_raised() {
+        return Err(e);
+    }
+    let mut all = result.map_err(eval_err)?;
+    let wanted: std::collections::BTreeSet<u32> = numbers.into_iter().collect();
+    all.retain(|r| wanted.contains(&r.task));
+    results_to_py(py, &all)
+}
