@@ -120,7 +120,7 @@ pub(super) fn params_arg(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String
 #[allow(clippy::too_many_arguments)]
 pub(super) fn evaluate(
     py: Python<'_>,
-    system: &Bound<'_, PyAny>,
+    system: Option<&Bound<'_, PyAny>>,
     worlds: Option<&Bound<'_, PyAny>>,
     tasks: Option<&Bound<'_, PyAny>>,
     jobs: Option<usize>,
@@ -134,24 +134,11 @@ pub(super) fn evaluate(
     resume: bool,
     force: bool,
 ) -> PyResult<Vec<Py<PyAny>>> {
-    if system.is_none() {
-        return evaluate(
-            py,
-            PyString::new(py, "pid").as_any(),
-            worlds,
-            tasks,
-            jobs,
-            vehicle,
-            params,
-            rules,
-            max_time,
-            seed,
-            scale,
-            out,
-            resume,
-            force,
-        );
-    }
+    let default = PyString::new(py, "pid");
+    let system = match system {
+        Some(s) if !s.is_none() => s,
+        _ => default.as_any(),
+    };
     if !system.is_instance_of::<PyString>() {
         let setup = EvalArgs {
             worlds,
