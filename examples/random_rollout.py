@@ -52,8 +52,8 @@ def main():
             break
     m = info["metrics"]
     print(f"{steps} steps, outcome {info['outcome']} after {m['time']:.1f} s, return {total:.1f}")
-    print(f"path {m['path_length']:.1f} m, {m['final_distance']:.1f} m left, mean |roll| {m['roll_mean_abs']:.1f} deg, "
-          f"mean |pitch| {m['pitch_mean_abs']:.1f} deg")
+    print(f"path {m['path_length']:.1f} m, {m['final_distance']:.1f} m left, mean |roll| {m['roll']['abs']['mean']:.1f} deg, "
+          f"mean |pitch| {m['pitch']['abs']['mean']:.1f} deg")
     write_png(args.png, env.render())
     print(f"wrote {args.png}")
     env.close()

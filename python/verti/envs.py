@@ -9,7 +9,8 @@ Each step holds the action for one control period (0.1 s at the default 10 Hz) a
 benchmark's own inner loop inside it (speed controller and termination rules every 10 ms), so
 episodes end exactly as benchmark trials do: ``terminated`` on success, stuck, rollover or a
 simulation error; ``truncated`` at the time limit. ``info["outcome"]`` names the outcome and
-``info["metrics"]`` carries the trial metrics when an episode ends.
+``info["metrics"]`` carries the trial record when an episode ends (the same dict as a line of
+results.jsonl, and as `verti.evaluate` returns).
 
 Observation (a ``Dict``):
 
