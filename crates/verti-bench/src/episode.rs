@@ -18,7 +18,7 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 use std::time::Instant;
 use verti_core::rng::mix_seed;
-use verti_sim::{Controls, Sim, SimState, VehicleSpec, start_pose};
+use verti_sim::{Controls, Sim, SimState, StartPose, VehicleSpec};
 use verti_world::{TaskId, World};
 
 /// Which success and failure rules apply.
@@ -424,13 +424,15 @@ pub fn run_episode(
         .find(|t| t.pair == pair)
         .copied()
         .expect("task_info found it");
-    let sim = match start_pose(world, spec, task.start[0], task.start[1], task.start_yaw())
-        .and_then(|p| Sim::new(world, spec, p))
-    {
+    let start = StartPose::new(task.start[0], task.start[1], task.start_yaw());
+    let started = Sim::new(world, spec).and_then(|sim| {
+        let state = sim.state_at(start)?;
+        Ok((sim, state))
+    });
+    let (sim, mut state) = match started {
         Ok(s) => s,
         Err(e) => return fail(result, format!("cannot start the simulation: {e}"), wall),
     };
-    let mut state = sim.initial_state();
     system.reset(&info);
     let rate = system.control_rate();
     if !(rate.is_finite() && rate > 0.0 && rate <= 1000.0) {

@@ -19,7 +19,7 @@ use verti_bench::observation::{CropSpec, Pose6, test_observation};
 use verti_bench::speed::SpeedController;
 use verti_core::Rng;
 use verti_render::{RenderOptions, WorldImage, render_world};
-use verti_sim::{Controls, Sim, SimState, VehicleSpec, start_pose};
+use verti_sim::{Controls, Sim, SimState, StartPose, VehicleSpec};
 use verti_systems::path::PathFollower;
 use verti_world::{ElevationLevel, ObstacleDensity, Task, TaskId, TerrainType, World};
 
@@ -518,15 +518,7 @@ impl EnvCore {
         let sim = match cached {
             Some(s) => s,
             None => {
-                let built = start_pose(
-                    world,
-                    &self.spec,
-                    task.start[0],
-                    task.start[1],
-                    task.start_yaw(),
-                )
-                .and_then(|p| Sim::new(world, &self.spec, p))
-                .map_err(|e| {
+                let built = Sim::new(world, &self.spec).map_err(|e| {
                     format!(
                         "cannot start the simulation on {} pair {pair}: {e}",
                         world.meta.name
@@ -541,7 +533,13 @@ impl EnvCore {
                 s
             }
         };
-        let state = sim.initial_state();
+        let start = StartPose::new(task.start[0], task.start[1], task.start_yaw());
+        let state = sim.state_at(start).map_err(|e| {
+            format!(
+                "cannot start the simulation on {} pair {pair}: {e}",
+                world.meta.name
+            )
+        })?;
         let pose = pose6(&sim, &state);
         let path = world
             .paths

@@ -803,6 +803,8 @@ impl PySimState {
 pub struct PySim {
     sim: Arc<verti_sim::Sim>,
     state: verti_sim::SimState,
+    /// Where `reset` puts the vehicle back.
+    start: verti_sim::StartPose,
 }
 
 #[pymethods]
@@ -833,15 +835,17 @@ impl PySim {
                 }
             }
         };
-        let sim = detached(py, || {
-            verti_sim::start_pose(&w, &spec, x, y, yaw)
-                .and_then(|p| verti_sim::Sim::new(&w, &spec, p))
+        let start = verti_sim::StartPose::new(x, y, yaw);
+        let (sim, state) = detached(py, || {
+            let sim = verti_sim::Sim::new(&w, &spec)?;
+            let state = sim.state_at(start)?;
+            Ok::<_, verti_sim::SimError>((sim, state))
         })?
         .map_err(sim_err)?;
-        let state = sim.initial_state();
         Ok(PySim {
             sim: Arc::new(sim),
             state,
+            start,
         })
     }
 
@@ -913,8 +917,9 @@ impl PySim {
     }
 
     /// Back to the start, at rest.
-    fn reset(&mut self) {
-        self.state = self.sim.initial_state();
+    fn reset(&mut self) -> PyResult<()> {
+        self.state = self.sim.state_at(self.start).map_err(sim_err)?;
+        Ok(())
     }
 
     /// A snapshot of the current state; assigning one (from this Sim or a clone) restores it.
@@ -940,6 +945,7 @@ impl PySim {
         PySim {
             sim: self.sim.clone(),
             state: self.state.clone(),
+            start: self.start,
         }
     }
     fn __copy__(&self) -> PySim {
@@ -1641,9 +1647,11 @@ impl PyEnvCore {
             .core
             .episode()
             .ok_or_else(|| value_err("call reset() first".into()))?;
+        let t = &ep.task;
         Ok(PySim {
             sim: ep.sim_arc(),
             state: ep.state().clone(),
+            start: verti_sim::StartPose::new(t.start[0], t.start[1], t.start_yaw()),
         })
     }
 }
