@@ -16,6 +16,7 @@ const OBSTACLE_STIFFENING: f64 = 4.0;
 
 /// Applies the chassis contacts with terrain and the obstacles `near` to `loads`; counts the
 /// contact points in `contacts`. `mu_body`: the chassis' own friction coefficient.
+#[inline]
 pub(crate) fn body_contacts(
     terrain: &Terrain,
     model: &Model,

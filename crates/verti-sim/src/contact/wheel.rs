@@ -14,6 +14,7 @@ pub(crate) const MAX_SOIL_NODES_PER_WHEEL: usize = 4096;
 
 /// Contact of one wheel with rigid terrain, obstacles (indices `near`) and soil. Writes the
 /// soil's plastic memory under the wheel. `soil_b`: the size of the wheel's last soil patch.
+#[inline]
 pub(crate) fn wheel_contact(
     terrain: &Terrain,
     soil: &mut SoilState,
