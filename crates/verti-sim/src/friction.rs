@@ -281,20 +281,21 @@ pub(crate) fn relax_slip(ws: &mut WheelState, tyre_forces: &TyreForces, tyre: &T
 /// needed force's direction, within the rising part of the curve.
 pub(crate) fn static_slip(fx: f64, fy: f64, tyre: &TyreSpec) -> (f64, f64) {
     let need = fx.hypot(fy);
-    if !(need > 1e-9) {
-        return (0.0, 0.0);
-    }
-    let dir = (fx / tyre.dfx0, fy / tyre.dfy0);
-    let dn = dir.0.hypot(dir.1);
-    let (mut lo, mut hi) = (0.0, tyre.sxm.min(tyre.sym) / dn.max(1e-12) * 0.999);
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        let (cx, cy) = tmeasy_combined(mid * dir.0, mid * dir.1, tyre, 1.0);
-        if cx.hypot(cy) < need {
-            lo = mid
-        } else {
-            hi = mid
+    if need > 1e-9 {
+        let dir = (fx / tyre.dfx0, fy / tyre.dfy0);
+        let dn = dir.0.hypot(dir.1);
+        let (mut lo, mut hi) = (0.0, tyre.sxm.min(tyre.sym) / dn.max(1e-12) * 0.999);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            let (cx, cy) = tmeasy_combined(mid * dir.0, mid * dir.1, tyre, 1.0);
+            if cx.hypot(cy) < need {
+                lo = mid
+            } else {
+                hi = mid
+            }
         }
+        (lo * dir.0, lo * dir.1)
+    } else {
+        (0.0, 0.0) // no pull (or a NaN one): no deflection
     }
-    (lo * dir.0, lo * dir.1)
 }

@@ -35,6 +35,41 @@ impl Loads {
     }
 }
 
+impl Loads {
+    /// Adds a wheel's external force `f_ext` (gravity on its unsprung mass, the ground's normal
+    /// force, the lateral tyre force) and its suspension force `spring`. Across the suspension
+    /// axis `f_ext` acts on the whole vehicle; along it, only through the spring. `moments`:
+    /// the moments that reach the chassis directly (the soil's pressure moment off the axle,
+    /// the lateral tyre force's overturning moment). Returns `f_ext` along the axis.
+    #[inline]
+    pub fn add_wheel(
+        &mut self,
+        arm: Vec3,
+        up: Vec3,
+        f_ext: Vec3,
+        spring: f64,
+        moments: (Vec3, Vec3),
+    ) -> f64 {
+        let f_axis = f_ext.dot(up);
+        self.force += f_ext;
+        self.torque += arm.cross(f_ext - up * f_axis + up * spring) + moments.0 + moments.1;
+        self.wheel_axis_force += f_axis;
+        self.suspension_force += spring;
+        f_axis
+    }
+
+    /// Adds a force `f` on a wheel that has no suspension part of its own (the longitudinal tyre
+    /// force, after the spin solve). Returns `f` along the axis.
+    #[inline]
+    pub fn add_wheel_force(&mut self, arm: Vec3, up: Vec3, f: Vec3) -> f64 {
+        let f_axis = f.dot(up);
+        self.force += f;
+        self.torque += arm.cross(f - up * f_axis);
+        self.wheel_axis_force += f_axis;
+        f_axis
+    }
+}
+
 /// Chassis accelerations (world frame).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Accelerations {

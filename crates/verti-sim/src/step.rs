@@ -24,12 +24,12 @@ use crate::drivetrain::{self, SpinLoads};
 use crate::error::SimError;
 use crate::friction::{self, TyreForces};
 use crate::integrate::{self, Loads};
-use crate::model::GRAVITY;
+use crate::model::{GRAVITY, WheelModel};
 use crate::sim::Sim;
 use crate::spec::MAX_WHEELS;
 use crate::state::{ContactInfo, Controls, SimState, WheelState};
 use crate::suspension::{self, AxisLoad, spring_force};
-use verti_core::Vec3;
+use verti_core::{Quat, Vec3};
 
 impl Sim {
     /// Advances `state` by `dt` seconds with `controls` held. The internal step is the largest
@@ -67,11 +67,7 @@ impl Sim {
     /// One internal step: driver inputs, wheel forces, spins, body contacts, integration.
     fn substep(&self, st: &mut SimState, ctl: &Controls, h: f64) {
         let (spec, model, terrain) = (&self.spec, &self.model, &self.terrain);
-        let q = st.orientation;
-        let ex = q.rotate(Vec3::X);
-        let ey = q.rotate(Vec3::Y);
-        let up = q.rotate(Vec3::Z);
-        let omega_w = q.rotate(st.omega);
+        let frame = Frame::of(st);
         let gravity = Vec3::new(0.0, 0.0, -GRAVITY);
 
         // ---- driver: steering, engine and gearbox ----
@@ -89,54 +85,33 @@ impl Sim {
         let near = terrain.obstacles.near(st.position.x, st.position.y);
         for (w, m) in model.wheels.iter().enumerate() {
             let ws = st.wheels[w];
-            let (sin_steer, cos_steer) = drivetrain::ackermann_sin_cos(m, turn_radius);
-            let arm = q.rotate(m.attach + Vec3::Z * ws.compression);
-            let kin = WheelKinematics {
-                hub: st.position + arm,
-                axle: ex * (-sin_steer) + ey * cos_steer,
-                hub_velocity: st.velocity + omega_w.cross(arm) + up * ws.compression_rate,
-                up,
-                chassis_omega: omega_w,
-                spin: st.group_spin[m.group],
-            };
-            let contact = wheel_contact(
-                terrain,
-                &mut st.soil,
-                &spec.tyre,
-                m,
-                ws.soil_patch_b,
-                &kin,
-                near,
-            );
+            let kin = frame.wheel(st, m, &ws, turn_radius);
+            let soil_b = ws.soil_patch_b;
+            let contact = wheel_contact(terrain, &mut st.soil, &spec.tyre, m, soil_b, &kin, near);
             let spring = spring_force(m, &ws);
             let tyre = friction::tyre_forces(&spec.tyre, spec.scale, m, &ws, &contact, &kin, h);
 
-            // the spin gets rolling resistance and the soil pressure moment about the axle
+            // the spin gets rolling resistance and the soil pressure moment about the axle,
+            // the composite body everything else
             let axle_moment = contact.soil_moment.dot(kin.axle);
             spin_loads.add_wheel(m.group, tyre.roll_torque + axle_moment, &tyre.long);
-            // the composite body gets the rest
             let mut f_ext = gravity * m.unsprung_mass + contact.force;
             if tyre.long.active {
                 f_ext += tyre.lat_force;
             }
-            let f_axis = f_ext.dot(up);
-            loads.force += f_ext;
-            let soil_perp = contact.soil_moment - kin.axle * axle_moment;
-            loads.torque += arm.cross(f_ext - up * f_axis + up * spring.force)
-                + soil_perp
-                + tyre.contact_moment;
-            loads.wheel_axis_force += f_axis;
-            loads.suspension_force += spring.force;
+            let soil_off_axle = contact.soil_moment - kin.axle * axle_moment;
+            let moments = (soil_off_axle, tyre.contact_moment);
+            let f_axis = loads.add_wheel(kin.arm, frame.up, f_ext, spring.force, moments);
 
-            axis_loads[w] = AxisLoad::new(arm, f_axis, &spring, &contact);
+            axis_loads[w] = AxisLoad::new(kin.arm, f_axis, &spring, &contact);
             axles[w] = kin.axle;
             tyres[w] = tyre;
             record_wheel(&mut st.wheels[w], &mut contacts, &contact, &tyre);
         }
 
-        // ---- spin groups: drive, brakes (exact Coulomb), skid steering ----
+        // ---- spin groups: drive, brakes (exact Coulomb), skid steering; then the
+        // longitudinal tyre forces at the new spins and the drive reactions ----
         let reaction = drivetrain::solve_spins(spec, model, st, ctl, wheel_torque, &spin_loads, h);
-        // longitudinal tyre forces consistent with the new spins, onto the composite body
         for (w, m) in model.wheels.iter().enumerate() {
             let long = &tyres[w].long;
             if !long.active {
@@ -144,11 +119,7 @@ impl Sim {
                 continue;
             }
             let fx = long.force_at(st.group_spin[m.group]);
-            let f = long.e_long * fx;
-            let f_axis = f.dot(up);
-            loads.force += f;
-            loads.torque += axis_loads[w].arm.cross(f - up * f_axis);
-            loads.wheel_axis_force += f_axis;
+            let f_axis = loads.add_wheel_force(axis_loads[w].arm, frame.up, long.e_long * fx);
             axis_loads[w].external += f_axis;
             st.wheels[w].long_force = fx;
         }
@@ -158,38 +129,67 @@ impl Sim {
         }
 
         // ---- chassis body contacts ----
-        body_contacts(
-            terrain,
-            model,
-            spec.chassis.friction,
-            st,
-            near,
-            &mut loads,
-            &mut contacts,
-        );
+        let mu_body = spec.chassis.friction;
+        body_contacts(terrain, model, mu_body, st, near, &mut loads, &mut contacts);
 
-        // ---- integration: chassis accelerations, then the implicit wheel updates, then the
-        // chassis itself ----
+        // ---- integration: chassis accelerations, the implicit wheel updates against them,
+        // then the chassis itself ----
         let acc = integrate::accelerations(model, st, &loads);
-        let chassis_velocity = st.velocity;
-        for (w, m) in model.wheels.iter().enumerate() {
-            let ws = &mut st.wheels[w];
-            suspension::update_wheel(
-                ws,
-                m,
-                &axis_loads[w],
-                &acc,
-                chassis_velocity,
-                omega_w,
-                up,
-                h,
-            );
+        let v = st.velocity;
+        for ((ws, m), load) in st.wheels.iter_mut().zip(&model.wheels).zip(&axis_loads) {
+            suspension::update_wheel(ws, m, load, &acc, v, frame.omega, frame.up, h);
         }
         for (ws, tyre) in st.wheels.iter_mut().zip(&tyres) {
             friction::relax_slip(ws, tyre, &spec.tyre, h);
         }
         integrate::advance_chassis(model, st, &loads, &acc, h);
         st.contacts = contacts;
+    }
+}
+
+/// The chassis attitude at the start of an internal step: its axes and angular velocity in
+/// the world frame.
+struct Frame {
+    q: Quat,
+    ex: Vec3,
+    ey: Vec3,
+    up: Vec3,
+    omega: Vec3,
+}
+
+impl Frame {
+    #[inline]
+    fn of(st: &SimState) -> Frame {
+        let q = st.orientation;
+        Frame {
+            q,
+            ex: q.rotate(Vec3::X),
+            ey: q.rotate(Vec3::Y),
+            up: q.rotate(Vec3::Z),
+            omega: q.rotate(st.omega),
+        }
+    }
+
+    /// Where wheel `m` (state `ws`) is and how it moves.
+    #[inline]
+    fn wheel(
+        &self,
+        st: &SimState,
+        m: &WheelModel,
+        ws: &WheelState,
+        turn_radius: f64,
+    ) -> WheelKinematics {
+        let (sin_steer, cos_steer) = drivetrain::ackermann_sin_cos(m, turn_radius);
+        let arm = self.q.rotate(m.attach + Vec3::Z * ws.compression);
+        WheelKinematics {
+            arm,
+            hub: st.position + arm,
+            axle: self.ex * (-sin_steer) + self.ey * cos_steer,
+            hub_velocity: st.velocity + self.omega.cross(arm) + self.up * ws.compression_rate,
+            up: self.up,
+            chassis_omega: self.omega,
+            spin: st.group_spin[m.group],
+        }
     }
 }
 

@@ -19,6 +19,8 @@ use verti_core::Vec3;
 /// of its contact and friction stages.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct WheelKinematics {
+    /// Hub position relative to the centre of mass (the lever arm of the wheel's forces).
+    pub arm: Vec3,
     pub hub: Vec3,
     /// Spin axis, pointing to the wheel's left.
     pub axle: Vec3,
