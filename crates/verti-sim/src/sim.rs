@@ -74,9 +74,6 @@ impl Sim {
     pub fn reach(&self) -> f64 {
         self.model.reach
     }
-    pub(crate) fn model(&self) -> &Model {
-        &self.model
-    }
 
     /// Pose of the chassis reference frame (the frame the vehicle file is written in).
     pub fn reference_pose(&self, state: &SimState) -> Pose {

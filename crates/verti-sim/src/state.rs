@@ -131,7 +131,7 @@ pub struct ContactInfo {
 }
 
 /// Everything that changes during a simulation. `Clone` is cheap: a few hundred bytes plus one
-/// `Arc` for the soil, whose chunks are copied only when written (see [`crate::soil`]).
+/// `Arc` for the soil, whose chunks are copied only when written (see [`SoilState`]).
 ///
 /// The fields are the engine's to write (stage by stage, see `step.rs`); users read them
 /// through the accessors.
@@ -230,7 +230,7 @@ impl SimState {
     pub fn set_velocity(&mut self, sim: &Sim, velocity_world: Vec3) {
         self.velocity = velocity_world;
         let forward = self.orientation.rotate(Vec3::X).dot(velocity_world);
-        let model = sim.model();
+        let model = &sim.model;
         for (g, grp) in model.groups.iter().enumerate() {
             let r = grp
                 .wheels

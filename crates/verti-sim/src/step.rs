@@ -7,7 +7,7 @@
 //!    acting on the wheel's absolute motion (the wheel-hop mode is the stiffest in a vehicle);
 //! 2. per spin group, the spin and the tyres' longitudinal forces are solved together
 //!    (linearised slip curve), then Coulomb brakes exactly;
-//! 3. the transient slip relaxes implicitly (see [`crate::tyre`]).
+//! 3. the transient slip relaxes implicitly (`friction::relax_slip`; see [`crate::tyre`]).
 //!
 //! Every shipped vehicle is stable at its `internal_step`: 5 ms at full scale (Verti-Bench's
 //! step), 2 ms for the 1/6 and 1/10 vehicles. Stability at those steps is what the validation

@@ -155,7 +155,7 @@ pub fn soak_episode(
     out
 }
 
-/// Control step of the soak [s].
+/// Control step of the soak \[s\].
 pub const SOAK_CONTROL_DT: f64 = 0.01;
 
 /// Drives random inputs (held for random 0.1–2 s) through every world with every vehicle
