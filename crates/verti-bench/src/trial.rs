@@ -16,7 +16,7 @@ use crate::system::{Action, TaskInfo};
 use std::sync::Arc;
 use std::time::Instant;
 use verti_core::rng::mix_seed;
-use verti_sim::{Controls, Sim, SimState, VehicleSpec, start_pose};
+use verti_sim::{Controls, Sim, SimState, StartPose, VehicleSpec};
 use verti_world::{Task, TaskId, World};
 
 /// What one [`Trial::step`] did.
@@ -149,8 +149,8 @@ pub fn pose6(sim: &Sim, state: &SimState) -> Pose6 {
 }
 
 impl Trial {
-    /// Starts task `pair` of `world` with the vehicle model `sim` (built for this world; one
-    /// model serves every task of a world). `system` names who drives, for the results.
+    /// Starts task `pair` of `world` with the vehicle model `sim` (built for this world with
+    /// `Sim::new`; one model serves every task of a world). `system` names who drives, for the results.
     pub fn new(
         world: &Arc<World>,
         sim: Arc<Sim>,
@@ -167,8 +167,12 @@ impl Trial {
             .iter()
             .find(|t| t.pair == pair)
             .expect("task_info found it");
-        let state = start_pose(world, spec, task.start[0], task.start[1], task.start_yaw())
-            .and_then(|p| sim.state_at(p))
+        let state = sim
+            .state_at(StartPose::new(
+                task.start[0],
+                task.start[1],
+                task.start_yaw(),
+            ))
             .map_err(|e| format!("cannot start the simulation: {e}"))?;
         let pose = pose6(&sim, &state);
         let rules = Termination::new(world, task.goal, cfg, &pose);
@@ -203,14 +207,10 @@ impl Trial {
         system: &str,
     ) -> Result<Trial, String> {
         cfg.validate()?;
-        let task = world
-            .tasks
-            .iter()
-            .find(|t| t.pair == pair)
-            .ok_or_else(|| format!("world {} has no pair {pair}", world.meta.name))?;
-        let sim = start_pose(world, spec, task.start[0], task.start[1], task.start_yaw())
-            .and_then(|p| Sim::new(world, spec, p))
-            .map_err(|e| format!("cannot start the simulation: {e}"))?;
+        if !world.tasks.iter().any(|t| t.pair == pair) {
+            return Err(format!("world {} has no pair {pair}", world.meta.name));
+        }
+        let sim = Sim::new(world, spec).map_err(|e| format!("cannot start the simulation: {e}"))?;
         Trial::new(world, Arc::new(sim), pair, cfg, system)
     }
 

@@ -5,7 +5,8 @@ use crate::world_cmd::{CmdResult, load_set_with_progress};
 use clap::{Args, Subcommand};
 use std::path::Path;
 use std::sync::Arc;
-use verti_sim::{BenchWorlds, VehicleSpec, vehicles};
+use verti_sim::tools::BenchWorlds;
+use verti_sim::{VehicleSpec, vehicles};
 
 #[derive(Subcommand)]
 pub enum VehicleCommand {
@@ -124,7 +125,7 @@ pub fn run_sim(cmd: SimCommand) -> CmdResult {
             }
             let specs = vehicles_arg(&a.vehicle)?;
             let worlds = BenchWorlds::generated_for(&specs)?;
-            let report = verti_sim::bench(&worlds, &specs, a.seconds, a.runs);
+            let report = verti_sim::tools::bench(&worlds, &specs, a.seconds, a.runs);
             if a.json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else {
@@ -147,7 +148,7 @@ pub fn run_sim(cmd: SimCommand) -> CmdResult {
                 }
             }
             let pb = bar(a.steps, "soak");
-            let report = verti_sim::soak(&worlds, &specs, a.steps, a.seed, |done| {
+            let report = verti_sim::tools::soak(&worlds, &specs, a.steps, a.seed, |done| {
                 pb.set_position(done)
             });
             pb.finish_and_clear();

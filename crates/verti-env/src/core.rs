@@ -17,7 +17,7 @@ use verti_bench::path::PathFollower;
 use verti_bench::{Action, Trial};
 use verti_core::Rng;
 use verti_render::{RenderOptions, WorldImage, render_world};
-use verti_sim::{Controls, Sim, SimState, VehicleSpec, start_pose};
+use verti_sim::{Controls, Sim, SimState, VehicleSpec};
 use verti_world::{Task, TaskId, World};
 
 /// What a step reports besides the observation.
@@ -251,15 +251,7 @@ impl EnvCore {
             return Ok(s);
         }
         let world = &self.worlds[wi];
-        let built = start_pose(
-            world,
-            &self.spec,
-            task.start[0],
-            task.start[1],
-            task.start_yaw(),
-        )
-        .and_then(|p| Sim::new(world, &self.spec, p))
-        .map_err(|e| EnvError::Start {
+        let built = Sim::new(world, &self.spec).map_err(|e| EnvError::Start {
             world: world.meta.name.clone(),
             pair: task.pair,
             message: e.to_string(),

@@ -1,6 +1,7 @@
 //! Speed benchmark: `cargo run -p verti-sim --release --example bench -- [SECONDS] [RUNS] [VEHICLE...]`
-//! (the CLI's `verti sim bench` calls the same `verti_sim::bench`).
-use verti_sim::{BenchWorlds, bench, vehicles};
+//! (the CLI's `verti sim bench` calls the same `verti_sim::tools::bench`).
+use verti_sim::tools::{BenchWorlds, bench};
+use verti_sim::vehicles;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

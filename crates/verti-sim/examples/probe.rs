@@ -1,7 +1,7 @@
 //! Development probe: prints a short drive of a vehicle on a test world.
 //! `cargo run -p verti-sim --release --example probe -- hmmwv flat`
 use std::sync::Arc;
-use verti_sim::{Controls, Sim, start_pose, testing, vehicles};
+use verti_sim::{Controls, Sim, StartPose, testing, vehicles};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -20,13 +20,8 @@ fn main() {
         "roughsoil" => testing::rough_world(s, 2, 4.8, testing::RoughSurface::Soil),
         _ => testing::flat_world(s, 0.8),
     });
-    let sim = Sim::new(
-        &world,
-        &spec,
-        start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
-    )
-    .unwrap();
-    let mut st = sim.initial_state();
+    let sim = Sim::new(&world, &spec).unwrap();
+    let mut st = sim.state_at(StartPose::new(0.0, 0.0, 0.0)).unwrap();
     println!(
         "start z {:.4} energy {:.1}",
         st.com_position().z,

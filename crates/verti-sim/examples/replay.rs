@@ -4,7 +4,8 @@
 //! vehicle's scale) or `SET:INDEX` for a generated world.
 use std::sync::Arc;
 use verti_sim::testing::{self, RoughSurface};
-use verti_sim::{soak_episode, vehicles};
+use verti_sim::tools::soak_episode;
+use verti_sim::vehicles;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

@@ -1,8 +1,9 @@
 //! Random-input soak: `cargo run -p verti-sim --release --example soak -- [STEPS] [SEED]`
-//! (the CLI's `verti sim soak` calls the same `verti_sim::soak`).
+//! (the CLI's `verti sim soak` calls the same `verti_sim::tools::soak`).
 use std::sync::Arc;
 use verti_sim::testing::{self, RoughSurface};
-use verti_sim::{soak, vehicles};
+use verti_sim::tools::soak;
+use verti_sim::vehicles;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

@@ -1,7 +1,6 @@
 //! Development trace of the benchmark drive: `cargo run -p verti-sim --release --example trace -- hmmwv soil`
-use verti_sim::{
-    BenchWorlds, Sim, bench::bench_controls, bench::bench_route, start_pose, vehicles,
-};
+use verti_sim::tools::{BenchWorlds, bench_controls, bench_route};
+use verti_sim::{Sim, StartPose, vehicles};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -19,13 +18,10 @@ fn main() {
     };
     let (from, to) = bench_route(world);
     let yaw0 = (to[1] - from[1]).atan2(to[0] - from[0]);
-    let sim = Sim::new(
-        world,
-        &spec,
-        start_pose(world, &spec, from[0], from[1], yaw0).unwrap(),
-    )
-    .unwrap();
-    let mut st = sim.initial_state();
+    let sim = Sim::new(world, &spec).unwrap();
+    let mut st = sim
+        .state_at(StartPose::new(from[0], from[1], yaw0))
+        .unwrap();
     for k in 0..3000 {
         let c = bench_controls(&st, to, world.meta.scale);
         if let Err(e) = sim.step(&mut st, c, 0.02) {

@@ -4,41 +4,59 @@
 //! rocky and deformable terrain, fast enough for planners that roll it forward thousands of
 //! times per decision.
 //!
+//! The public API, at a glance:
 //! * [`VehicleSpec`]: the immutable vehicle description, read from YAML ([`vehicles`] ships
-//!   the built-in ones).
-//! * [`Sim`]: the immutable model of one vehicle on one [`verti_world::World`];
-//!   [`SimState`]: the mutable, cheap-to-clone state; [`Sim::step`] advances it.
-//! * [`start_pose`]: seats a vehicle on the terrain at a task start.
-//! * [`bench()`] and [`soak()`]: the speed benchmark and the random-input robustness run.
-//! * [`testing`]: small programmatic worlds for tests and benchmarks.
+//!   the built-in ones; [`spec`] holds the types of its parts).
+//! * [`Sim`]: the immutable model of one vehicle on one [`verti_world::World`], built once and
+//!   shared by any number of states and starts. [`Sim::state_at`] seats the vehicle at a
+//!   [`StartPose`] and gives its [`SimState`] at rest; [`Sim::step`] advances a state under
+//!   [`Controls`].
+//! * [`SimState`]: the mutable, cheap-to-clone state, with per-wheel [`WheelState`],
+//!   a [`ContactInfo`] summary and the [`SoilState`] deformation; [`Pose`] of the chassis.
+//! * [`SimError`] and [`SpecError`]: every failure is an error, never a panic.
+//! * [`testing`]: small programmatic worlds for tests; [`tools`]: the speed benchmark and the
+//!   soak behind `verti sim bench` / `verti sim soak`.
 //!
 //! ```no_run
 //! use std::sync::Arc;
-//! use verti_sim::{Controls, Sim, start_pose, testing, vehicles};
+//! use verti_sim::{Controls, Sim, StartPose, testing, vehicles};
 //! let world = Arc::new(testing::flat_world(1.0, 0.8));
 //! let spec = vehicles::builtin("hmmwv").unwrap();
-//! let sim = Sim::new(&world, &spec, start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap()).unwrap();
-//! let mut state = sim.initial_state();
+//! let sim = Sim::new(&world, &spec).unwrap();
+//! let mut state = sim.state_at(StartPose::new(0.0, 0.0, 0.0)).unwrap();
 //! sim.step(&mut state, Controls::new(0.5, 0.0, 0.1), 0.05).unwrap();
 //! println!("{:?} {}", state.euler(), state.forward_speed());
 //! ```
+//!
+//! # Inside
+//! One internal step runs stages over plain data (see `step.rs`, which reads as their list):
+//! `model` compiles the spec; `start` seats a vehicle; `drivetrain` steers, drives and solves
+//! the spins; `contact` (`wheel`, `soil`, `body`) finds normal forces; `friction` computes every
+//! tangential force; `suspension` and `integrate` advance the state. `terrain`, `soil` and
+//! `tyre` hold the lookup structures, the soil storage and the tyre curves they use.
 
-pub mod bench;
-pub mod error;
-pub mod powertrain;
-pub mod sim;
-pub mod soil;
+mod contact;
+mod drivetrain;
+mod error;
+mod friction;
+mod integrate;
+mod math;
+mod model;
+mod sim;
+mod soil;
 pub mod spec;
-pub mod terrain;
+mod start;
+mod state;
+mod step;
+mod suspension;
+mod terrain;
 pub mod testing;
-pub mod tyre;
+pub mod tools;
+mod tyre;
 pub mod vehicles;
 
-pub use bench::{
-    BenchCase, BenchReport, BenchWorlds, SoakEpisode, SoakFailure, SoakReport, bench, soak,
-    soak_episode,
-};
 pub use error::{SimError, SpecError};
-pub use sim::{ContactInfo, Controls, Pose, Sim, SimState, WheelState, start_pose};
+pub use sim::Sim;
 pub use soil::SoilState;
 pub use spec::VehicleSpec;
+pub use state::{ContactInfo, Controls, Pose, SimState, StartPose, WheelState};

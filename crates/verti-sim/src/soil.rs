@@ -14,6 +14,9 @@
 
 use std::sync::Arc;
 
+/// Soil node spacing at full scale \[m\] (Verti-Bench's SCM `terrain_delta`).
+pub const SOIL_DELTA_FULL_SCALE: f64 = 0.1;
+
 /// Nodes per chunk side.
 pub const CHUNK: usize = 32;
 const CHUNK_NODES: usize = CHUNK * CHUNK;

@@ -1,8 +1,53 @@
 //! Precomputed, immutable acceleration structures over a world, built once per [`crate::Sim`]:
 //! a coarse grid of maximum heights (so contact samples far above the ground are skipped
-//! without touching the heightfield) and a broad-phase grid of obstacle indices.
+//! without touching the heightfield), a fast copy of the ground surface, a broad-phase grid of
+//! obstacle indices and the soil node layout, bundled with the world as [`Terrain`].
 
+use crate::error::SimError;
+use crate::soil::{SOIL_DELTA_FULL_SCALE, SoilLayout};
+use std::sync::Arc;
 use verti_world::World;
+
+/// The world a vehicle drives on, with the lookup structures the contact stages use.
+#[derive(Clone, Debug)]
+pub(crate) struct Terrain {
+    pub world: Arc<World>,
+    pub bound: HeightBound,
+    pub ground: Ground,
+    /// Broad phase: obstacles within the vehicle's reach of each cell.
+    pub obstacles: ObstacleGrid,
+    /// `world.obstacles` in the form the contact loops want, same indices.
+    pub fast_obstacles: Vec<FastObstacle>,
+    /// The soil node grid, when the world has deformable patches.
+    pub soil: Option<SoilLayout>,
+}
+
+impl Terrain {
+    /// `reach`: the vehicle's bounding radius around its centre of mass (plus a margin).
+    pub fn new(world: &Arc<World>, reach: f64) -> Result<Terrain, SimError> {
+        let soil = if world.patches.has_soil() {
+            let delta = SOIL_DELTA_FULL_SCALE * world.meta.scale;
+            let layout = SoilLayout::new(world.terrain.half_extent(), delta);
+            if layout.chunks > 4096 {
+                return Err(SimError::InvalidSetup(format!(
+                    "soil grid of {} chunks per side is too large",
+                    layout.chunks
+                )));
+            }
+            Some(layout)
+        } else {
+            None
+        };
+        Ok(Terrain {
+            bound: HeightBound::new(world),
+            ground: Ground::new(world),
+            fast_obstacles: world.obstacles.iter().map(FastObstacle::new).collect(),
+            obstacles: ObstacleGrid::new(world, reach),
+            world: Arc::clone(world),
+            soil,
+        })
+    }
+}
 
 /// Heightfield cells per side of one bound block.
 const BLOCK_CELLS: usize = 2;

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 use verti_core::Vec3;
 use verti_sim::testing::{self, RoughSurface};
-use verti_sim::{Controls, Sim, SimError, SpecError, VehicleSpec, start_pose, vehicles};
+use verti_sim::{Controls, Sim, SimError, SpecError, StartPose, VehicleSpec, vehicles};
 use verti_world::SoilParams;
 
 #[test]
@@ -66,21 +66,17 @@ fn bad_vehicle_files_name_the_file_and_the_field() {
 fn bad_inputs_are_errors_not_panics() {
     let world = Arc::new(testing::flat_world(1.0, 0.8));
     let spec = vehicles::builtin("hmmwv").unwrap();
+    let sim = Sim::new(&world, &spec).unwrap();
     assert!(matches!(
-        start_pose(&world, &spec, 500.0, 0.0, 0.0),
+        sim.state_at(StartPose::new(500.0, 0.0, 0.0)),
         Err(SimError::InvalidStart(_))
     ));
     assert!(matches!(
-        start_pose(&world, &spec, f64::NAN, 0.0, 0.0),
+        sim.state_at(StartPose::new(f64::NAN, 0.0, 0.0)),
         Err(SimError::InvalidStart(_))
     ));
-    let sim = Sim::new(
-        &world,
-        &spec,
-        start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
-    )
-    .unwrap();
-    let mut st = sim.initial_state();
+    let start = StartPose::new(0.0, 0.0, 0.0);
+    let mut st = sim.state_at(start).unwrap();
     for (c, name) in [
         (Controls::new(f64::NAN, 0.0, 0.0), "throttle"),
         (Controls::new(0.0, 1.5, 0.0), "brake"),
@@ -107,7 +103,7 @@ fn bad_inputs_are_errors_not_panics() {
         "{e}"
     );
     // a fresh state is unaffected
-    let mut fresh = sim.initial_state();
+    let mut fresh = sim.state_at(start).unwrap();
     sim.step(&mut fresh, Controls::IDLE, 0.01).unwrap();
 }
 
@@ -124,13 +120,9 @@ fn every_vehicle_drives_every_kind_of_world() {
         for world in worlds {
             let name = world.meta.name.clone();
             let world = Arc::new(world);
-            let sim = Sim::new(
-                &world,
-                &spec,
-                start_pose(&world, &spec, 0.0, 0.0, 0.2).unwrap(),
-            )
-            .unwrap();
-            let mut st = sim.initial_state();
+            let sim = Sim::new(&world, &spec).unwrap();
+            let start = StartPose::new(0.0, 0.0, 0.2);
+            let mut st = sim.state_at(start).unwrap();
             let start = sim.reference_pose(&st).position;
             for k in 0..300 {
                 let c = Controls::new(0.5, 0.0, if k > 150 { 0.3 } else { 0.0 });
@@ -155,13 +147,9 @@ fn every_vehicle_drives_every_kind_of_world() {
 fn state_accessors_are_consistent() {
     let world = Arc::new(testing::flat_world(1.0, 0.8));
     let spec = vehicles::builtin("hmmwv").unwrap();
-    let sim = Sim::new(
-        &world,
-        &spec,
-        start_pose(&world, &spec, 2.0, -3.0, 1.0).unwrap(),
-    )
-    .unwrap();
-    let mut st = sim.initial_state();
+    let sim = Sim::new(&world, &spec).unwrap();
+    let start = StartPose::new(2.0, -3.0, 1.0);
+    let mut st = sim.state_at(start).unwrap();
     for _ in 0..100 {
         sim.step(&mut st, Controls::new(0.5, 0.0, 0.0), 0.02)
             .unwrap();
@@ -193,20 +181,19 @@ fn state_accessors_are_consistent() {
 fn soil_is_copy_on_write_and_ruts_persist() {
     let world = Arc::new(testing::soil_world(1.0, SoilParams::SOFT, 0.0));
     let spec = vehicles::builtin("hmmwv").unwrap();
-    let sim = Sim::new(
-        &world,
-        &spec,
-        start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
-    )
-    .unwrap();
-    let mut st = sim.initial_state();
+    let sim = Sim::new(&world, &spec).unwrap();
+    let start = StartPose::new(0.0, 0.0, 0.0);
+    let mut st = sim.state_at(start).unwrap();
     for _ in 0..100 {
         sim.step(&mut st, Controls::new(0.6, 0.0, 0.0), 0.02)
             .unwrap();
     }
     assert!(st.contacts().wheels_on_soil == 4 && st.soil().deformed_nodes() > 50);
     // the start spot is now a rut (the wheels sat there) and stays one
-    let front_start = sim.point_world(&sim.initial_state(), Vec3::new(spec.axles[0].x, 0.0, 0.0));
+    let front_start = sim.point_world(
+        &sim.state_at(start).unwrap(),
+        Vec3::new(spec.axles[0].x, 0.0, 0.0),
+    );
     let side = 0.5 * spec.axles[0].track;
     let rut = sim.ground_height_at(&st, front_start.x, front_start.y + side);
     assert!(rut < -0.05, "rut depth {rut:.3} m");
@@ -225,13 +212,9 @@ fn a_vehicle_too_big_for_the_soil_grid_drives_on_it_as_rigid_ground() {
     // HMMWV on a 1/10-scale soil world: 1 cm nodes, tens of thousands under each wheel
     let world = Arc::new(testing::soil_world(0.1, SoilParams::MID, 0.0));
     let spec = vehicles::builtin("hmmwv").unwrap();
-    let sim = Sim::new(
-        &world,
-        &spec,
-        start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
-    )
-    .unwrap();
-    let mut st = sim.initial_state();
+    let sim = Sim::new(&world, &spec).unwrap();
+    let start = StartPose::new(0.0, 0.0, 0.0);
+    let mut st = sim.state_at(start).unwrap();
     for _ in 0..100 {
         sim.step(&mut st, Controls::new(0.3, 0.0, 0.0), 0.02)
             .unwrap();
@@ -249,13 +232,9 @@ fn a_vehicle_too_small_for_the_soil_grid_does_not_fall_through() {
     // 1/10 crawler on a full-scale soil world: 0.1 m nodes, a 4 cm tread
     let world = Arc::new(testing::soil_world(1.0, SoilParams::SOFT, 0.0));
     let spec = vehicles::builtin("verti4").unwrap();
-    let sim = Sim::new(
-        &world,
-        &spec,
-        start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
-    )
-    .unwrap();
-    let mut st = sim.initial_state();
+    let sim = Sim::new(&world, &spec).unwrap();
+    let start = StartPose::new(0.0, 0.0, 0.0);
+    let mut st = sim.state_at(start).unwrap();
     for _ in 0..100 {
         sim.step(&mut st, Controls::new(0.3, 0.0, 0.0), 0.02)
             .unwrap();
@@ -273,14 +252,10 @@ fn positive_steering_turns_left_for_wheeled_and_tracked_vehicles() {
     for name in ["hmmwv", "artcar", "truck8", "m113"] {
         let spec = vehicles::builtin(name).unwrap();
         let world = Arc::new(testing::flat_world(spec.scale, 0.8));
-        let sim = Sim::new(
-            &world,
-            &spec,
-            start_pose(&world, &spec, 0.0, 0.0, 0.0).unwrap(),
-        )
-        .unwrap();
+        let sim = Sim::new(&world, &spec).unwrap();
+        let start = StartPose::new(0.0, 0.0, 0.0);
         for steer in [0.5, -0.5] {
-            let mut st = sim.initial_state();
+            let mut st = sim.state_at(start).unwrap();
             for _ in 0..200 {
                 sim.step(&mut st, Controls::new(0.6, 0.0, steer), 0.02)
                     .unwrap();

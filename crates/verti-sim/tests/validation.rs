@@ -5,7 +5,7 @@ use std::sync::Arc;
 use verti_core::{Rng, Vec3};
 use verti_sim::spec::{Differential, VehicleSpec};
 use verti_sim::testing::{self, RoughSurface};
-use verti_sim::{Controls, Sim, SimState, start_pose, vehicles};
+use verti_sim::{Controls, Sim, SimState, StartPose, vehicles};
 use verti_world::{SoilParams, World};
 
 const G: f64 = 9.81;
@@ -16,9 +16,8 @@ fn hmmwv() -> VehicleSpec {
 
 fn sim_at(world: World, spec: &VehicleSpec, x: f64, y: f64, yaw: f64) -> (Sim, SimState) {
     let world = Arc::new(world);
-    let pose = start_pose(&world, spec, x, y, yaw).unwrap();
-    let sim = Sim::new(&world, spec, pose).unwrap();
-    let state = sim.initial_state();
+    let sim = Sim::new(&world, spec).unwrap();
+    let state = sim.state_at(StartPose::new(x, y, yaw)).unwrap();
     (sim, state)
 }
 
@@ -616,14 +615,10 @@ fn random_drive(sim: &Sim, st: &mut SimState, seed: u64, steps: usize) -> Vec<u6
 fn bit_identical_trajectories_and_clones() {
     let world = Arc::new(testing::rough_world(1.0, 7, 8.0, RoughSurface::Mixed));
     let spec = hmmwv();
-    let sim = Sim::new(
-        &world,
-        &spec,
-        start_pose(&world, &spec, 0.0, 0.0, 0.5).unwrap(),
-    )
-    .unwrap();
-    let mut a = sim.initial_state();
-    let mut b = sim.initial_state();
+    let sim = Sim::new(&world, &spec).unwrap();
+    let start = StartPose::new(0.0, 0.0, 0.5);
+    let mut a = sim.state_at(start).unwrap();
+    let mut b = sim.state_at(start).unwrap();
     let ta = random_drive(&sim, &mut a, 11, 500);
     let tb = random_drive(&sim, &mut b, 11, 500);
     assert_eq!(ta, tb);

@@ -5,8 +5,8 @@
 
 use std::sync::Arc;
 use verti_bench::MobilitySystem;
-use verti_bench::task_info;
 use verti_bench::observation::test_observation;
+use verti_bench::task_info;
 use verti_systems::mppi::{Mppi, MppiParams};
 use verti_world::generate::{SetConfig, generate_set};
 

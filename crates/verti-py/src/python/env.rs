@@ -396,9 +396,11 @@ impl PyEnvCore {
             .core
             .episode()
             .ok_or_else(|| value_err("call reset() first".into()))?;
+        let t = ep.task();
         Ok(PySim {
             sim: ep.sim_arc(),
             state: ep.state().clone(),
+            start: verti_sim::StartPose::new(t.start[0], t.start[1], t.start_yaw()),
         })
     }
 }

@@ -126,6 +126,8 @@ impl PySimState {
 pub struct PySim {
     pub(super) sim: Arc<verti_sim::Sim>,
     pub(super) state: verti_sim::SimState,
+    /// Where `reset` puts the vehicle back.
+    pub(super) start: verti_sim::StartPose,
 }
 
 #[pymethods]
@@ -156,15 +158,17 @@ impl PySim {
                 }
             }
         };
-        let sim = detached(py, || {
-            verti_sim::start_pose(&w, &spec, x, y, yaw)
-                .and_then(|p| verti_sim::Sim::new(&w, &spec, p))
+        let start = verti_sim::StartPose::new(x, y, yaw);
+        let (sim, state) = detached(py, || {
+            let sim = verti_sim::Sim::new(&w, &spec)?;
+            let state = sim.state_at(start)?;
+            Ok::<_, verti_sim::SimError>((sim, state))
         })?
         .map_err(sim_err)?;
-        let state = sim.initial_state();
         Ok(PySim {
             sim: Arc::new(sim),
             state,
+            start,
         })
     }
 
@@ -236,8 +240,9 @@ impl PySim {
     }
 
     /// Back to the start, at rest.
-    fn reset(&mut self) {
-        self.state = self.sim.initial_state();
+    fn reset(&mut self) -> PyResult<()> {
+        self.state = self.sim.state_at(self.start).map_err(sim_err)?;
+        Ok(())
     }
 
     /// A snapshot of the current state; assigning one (from this Sim or a clone) restores it.
@@ -263,6 +268,7 @@ impl PySim {
         PySim {
             sim: self.sim.clone(),
             state: self.state.clone(),
+            start: self.start,
         }
     }
     fn __copy__(&self) -> PySim {

@@ -1,0 +1,71 @@
+//! Contact stages: normal forces between the vehicle and the world.
+//!
+//! * [`wheel`]: one wheel against rigid ground and obstacles (a compliant tyre), handing the
+//!   soil under it to [`soil`];
+//! * [`soil`]: SCM under one wheel (pressure–sinkage per node, plastic memory);
+//! * [`body`]: the chassis collision box against terrain and obstacles.
+//!
+//! Wheel contacts return a [`WheelContact`] summary; their tangential forces come later from
+//! the slip state (`friction::tyre_forces`). Body contacts apply their forces, friction
+//! included, directly.
+
+pub(crate) mod body;
+pub(crate) mod soil;
+pub(crate) mod wheel;
+
+use verti_core::Vec3;
+
+/// A wheel's placement and motion at the start of an internal step (world frame): the input
+/// of its contact and friction stages.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WheelKinematics {
+    /// Hub position relative to the centre of mass (the lever arm of the wheel's forces).
+    pub arm: Vec3,
+    pub hub: Vec3,
+    /// Spin axis, pointing to the wheel's left.
+    pub axle: Vec3,
+    pub hub_velocity: Vec3,
+    /// The chassis z axis, along which the suspension moves.
+    pub up: Vec3,
+    /// Chassis angular velocity.
+    pub chassis_omega: Vec3,
+    /// Spin rate of the wheel's group \[rad/s\].
+    pub spin: f64,
+}
+
+/// Contact of one wheel with everything (summed).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct WheelContact {
+    /// Summed normal force (world).
+    pub force: Vec3,
+    /// Stiffness and damping along the suspension axis (for the implicit wheel update).
+    pub k_axis: f64,
+    pub c_axis: f64,
+    /// Σ k·(n·u)·n and Σ c·(n·u)·n: how the axis force depends on the chassis' motion.
+    pub k_vec: Vec3,
+    pub c_vec: Vec3,
+    /// Rigid part: normal load and friction scale (ground μ / tyre μ), load-weighted.
+    pub rigid_load: f64,
+    pub mu_scale: f64,
+    /// Deepest rigid penetration \[m\] (loaded-radius correction).
+    pub depth: f64,
+    /// Soil part.
+    pub soil_load: f64,
+    pub soil_shear_limit: f64,
+    pub soil_length: f64,
+    pub soil_janosi_k: f64,
+    pub soil_moment: Vec3,
+    pub soil_nodes: u32,
+    /// b = 2A/L of this step's soil patch.
+    pub soil_b: f64,
+    pub sinkage: f64,
+    pub obstacle: bool,
+}
+
+impl WheelContact {
+    /// Total normal load \[N\].
+    #[inline]
+    pub fn normal_load(&self) -> f64 {
+        self.rigid_load + self.soil_load
+    }
+}

@@ -1,0 +1,238 @@
+//! Drivetrain stages: steering, engine and gearbox, and the spin of each spin group under
+//! drive, tyre and brake torques.
+//!
+//! The engine (torque map) and automatic transmission are Chrono's `ChEngineSimpleMap` and
+//! `ChAutomaticTransmissionSimpleMap`: no torque converter, so the engine speed is tied to the
+//! driven wheels' mean speed through the gear and final-drive ratios.
+
+use crate::friction::LongTyre;
+use crate::math::soft_sign;
+use crate::model::{Model, WheelModel};
+use crate::spec::{MAX_WHEELS, PowertrainSpec, SteeringKind, VehicleSpec};
+use crate::state::{Controls, SimState};
+
+pub(crate) const RPM_TO_RAD_S: f64 = std::f64::consts::PI / 30.0;
+
+// ---- steering ----
+
+/// Moves the steering toward the driver's input: the bicycle-model angle at the steering's
+/// slew rate (Ackermann), or the input itself (skid steering). Returns the turn radius of the
+/// rear-axle centre (infinite when straight or skid-steered).
+#[inline]
+pub(crate) fn steer(
+    spec: &VehicleSpec,
+    model: &Model,
+    st: &mut SimState,
+    ctl: &Controls,
+    h: f64,
+) -> f64 {
+    if spec.steering.kind == SteeringKind::Skid {
+        st.steer = ctl.steering;
+    } else {
+        let target = ctl.steering * spec.steering.max_angle_deg.to_radians();
+        let max_delta = spec.steering.rate_deg_per_s.to_radians() * h;
+        st.steer += (target - st.steer).clamp(-max_delta, max_delta);
+    }
+    turn_radius(spec, model, st.steer)
+}
+
+/// Turn radius of the rear-axle centre for a bicycle steer angle (infinite when straight or
+/// skid-steered).
+#[inline]
+pub(crate) fn turn_radius(spec: &VehicleSpec, model: &Model, steer: f64) -> f64 {
+    if spec.steering.kind == SteeringKind::Ackermann && steer.abs() > 1e-9 {
+        model.wheelbase / libm::tan(steer)
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// (sin δ, cos δ) of a wheel's steer angle δ. Ackermann: the wheel points at the turn centre
+/// on the rear-axle line, so tan δ = dx / (R − y); sine and cosine follow without
+/// trigonometric calls.
+#[inline]
+pub(crate) fn ackermann_sin_cos(m: &WheelModel, turn_radius: f64) -> (f64, f64) {
+    if m.steered && turn_radius.is_finite() {
+        let d = turn_radius - m.y;
+        let hyp = (m.ackermann_dx * m.ackermann_dx + d * d).sqrt();
+        (m.ackermann_dx * d.signum() / hyp, d.abs() / hyp)
+    } else {
+        (0.0, 1.0)
+    }
+}
+
+/// A wheel's steer angle \[rad\] (an output only).
+#[inline]
+pub(crate) fn ackermann_angle(m: &WheelModel, turn_radius: f64) -> f64 {
+    if m.steered && turn_radius.is_finite() {
+        libm::atan(m.ackermann_dx / (turn_radius - m.y))
+    } else {
+        0.0
+    }
+}
+
+// ---- engine and gearbox ----
+
+/// Shifts gear, then returns the total drive torque at the wheels \[N m\] (records the engine
+/// speed and torque in `st`).
+#[inline]
+pub(crate) fn engine(spec: &VehicleSpec, model: &Model, st: &mut SimState, throttle: f64) -> f64 {
+    let p = &spec.powertrain;
+    let mut mean_spin = 0.0;
+    for m in &model.wheels {
+        if m.driven {
+            mean_spin += st.group_spin[m.group];
+        }
+    }
+    mean_spin /= model.driven_wheels as f64;
+    let engine_speed_of = |gear: usize| mean_spin.abs() / (p.final_drive * p.gears[gear]);
+    st.gear = shift(p, st.gear, engine_speed_of(st.gear));
+    let ratio = p.final_drive * p.gears[st.gear];
+    let we = engine_speed_of(st.gear);
+    // Closed-throttle drag opposes the rotation (smoothly through zero) so coasting never
+    // gains energy; the full-throttle part always drives forward.
+    let drag_sign = soft_sign(mean_spin / ratio / 5.0);
+    let t_full = engine_torque(p, we, 1.0);
+    let t_zero = engine_torque(p, we, 0.0);
+    let te = t_full * throttle + t_zero * (1.0 - throttle) * drag_sign;
+    st.engine_speed = we;
+    st.engine_torque = te;
+    te / ratio
+}
+
+/// Piecewise-linear interpolation in a map of (x, y) points with increasing x; clamps at the
+/// ends.
+#[inline]
+pub(crate) fn interpolate(map: &[[f64; 2]], x: f64) -> f64 {
+    let first = map[0];
+    if x <= first[0] {
+        return first[1];
+    }
+    for w in map.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if x <= b[0] {
+            let t = (x - a[0]) / (b[0] - a[0]);
+            return a[1] + t * (b[1] - a[1]);
+        }
+    }
+    map[map.len() - 1][1]
+}
+
+/// Engine torque \[N m\] at engine speed `omega` \[rad/s\] and throttle in \[0, 1\]:
+/// `T = T0(ω)·(1 − throttle) + TF(ω)·throttle`, speed clamped to \[0, max\].
+#[inline]
+pub(crate) fn engine_torque(p: &PowertrainSpec, omega: f64, throttle: f64) -> f64 {
+    let w = omega.clamp(0.0, p.max_speed_rpm * RPM_TO_RAD_S);
+    interpolate(&p.zero_throttle, w) * (1.0 - throttle)
+        + interpolate(&p.full_throttle, w) * throttle
+}
+
+/// The gear after applying the shift rules once at engine speed `omega` \[rad/s\].
+#[inline]
+pub(crate) fn shift(p: &PowertrainSpec, gear: usize, omega: f64) -> usize {
+    let rpm = omega / RPM_TO_RAD_S;
+    if rpm > p.upshift_rpm && gear + 1 < p.gears.len() {
+        gear + 1
+    } else if rpm < p.downshift_rpm && gear > 0 {
+        gear - 1
+    } else {
+        gear
+    }
+}
+
+// ---- spin groups ----
+
+/// Torques on each spin group from its tyres, gathered wheel by wheel: explicit torques and
+/// the linearised longitudinal tyre forces' dependence on the new spin.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SpinLoads {
+    /// Torque not depending on the new spin \[N m\].
+    pub torque: [f64; MAX_WHEELS],
+    /// d(torque)/d(new spin) with its sign flipped \[N m s\].
+    pub stiffness: [f64; MAX_WHEELS],
+}
+
+impl SpinLoads {
+    pub const ZERO: SpinLoads = SpinLoads {
+        torque: [0.0; MAX_WHEELS],
+        stiffness: [0.0; MAX_WHEELS],
+    };
+
+    /// One wheel's share: `explicit` (rolling resistance, the soil pressure moment about the
+    /// axle) and its longitudinal tyre force.
+    #[inline]
+    pub fn add_wheel(&mut self, group: usize, explicit: f64, long: &LongTyre) {
+        self.torque[group] += explicit;
+        if long.active {
+            self.stiffness[group] += long.spin_stiffness();
+            self.torque[group] -= long.spin_torque_offset();
+        }
+    }
+}
+
+/// Solves each spin group's new spin rate under drive, tyre and brake torques (writes
+/// `st.group_spin`) and returns the reaction torque each group's wheels put on the chassis
+/// \[N m per wheel\].
+///
+/// Implicit spin: (I/h + K)·ω_new = I·ω/h + T, with K the tyres' linearised longitudinal
+/// stiffness against the spin, then Coulomb brakes solved exactly. Explicitly, a heavily
+/// loaded tyre (impacts) overshoots the no-slip speed within one step and pumps energy into
+/// the vehicle. Skid steering biases the drive toward the outer side and brakes the inner one.
+#[inline]
+pub(crate) fn solve_spins(
+    spec: &VehicleSpec,
+    model: &Model,
+    st: &mut SimState,
+    ctl: &Controls,
+    wheel_torque: f64,
+    loads: &SpinLoads,
+    h: f64,
+) -> [f64; MAX_WHEELS] {
+    let skid = spec.steering.kind == SteeringKind::Skid;
+    let brake_in = ctl.brake;
+    let mut group_reaction = [0.0; MAX_WHEELS];
+    for (g, grp) in model.groups.iter().enumerate() {
+        let mut share = grp.drive_share;
+        let mut brake_max = 0.0;
+        for &w in &grp.wheels {
+            brake_max += model.wheels[w].brake_torque * brake_in;
+        }
+        if skid {
+            // positive steering turns left: more torque right, brake the left (inner) side
+            share *= 1.0 - grp.side * st.steer;
+            if grp.side * st.steer > 0.0 {
+                brake_max +=
+                    spec.steering.skid_brake_torque * st.steer.abs() * grp.wheels.len() as f64;
+            }
+        }
+        let drive = wheel_torque * share;
+        let w0 = st.group_spin[g];
+        let x = grp.inertia * w0 / h + drive + loads.torque[g];
+        let denom = grp.inertia / h + loads.stiffness[g];
+        let (w1, brake_applied) = if x.abs() <= brake_max {
+            (0.0, -x)
+        } else {
+            (
+                (x - x.signum() * brake_max) / denom,
+                -x.signum() * brake_max,
+            )
+        };
+        st.group_spin[g] = w1;
+        group_reaction[g] = -(drive + brake_applied) / grp.wheels.len() as f64;
+    }
+    group_reaction
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interpolation_clamps_and_is_linear() {
+        let m = [[0.0, 1.0], [2.0, 3.0], [4.0, -1.0]];
+        assert_eq!(interpolate(&m, -1.0), 1.0);
+        assert_eq!(interpolate(&m, 1.0), 2.0);
+        assert_eq!(interpolate(&m, 3.0), 1.0);
+        assert_eq!(interpolate(&m, 9.0), -1.0);
+    }
+}

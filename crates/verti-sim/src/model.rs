@@ -1,0 +1,338 @@
+//! Model compilation: a [`VehicleSpec`] (what the vehicle file says) becomes a [`Model`] (what
+//! the inner loops want): masses and inertias about the centre of mass, per-wheel constants,
+//! spin groups, the chassis collision lattice and contact stiffnesses sized from the step.
+//!
+//! # Mass model
+//! The chassis is a rigid body with 6 degrees of freedom (position, unit quaternion). Each wheel
+//! has a suspension degree of freedom along the chassis z axis (spring, damper, bump and rebound
+//! stops) carrying its unsprung mass, and belongs to a *spin group*: one spin degree of freedom
+//! per set of wheels a locked differential (or a track) ties together. Sideways and fore-aft,
+//! the wheels move with the chassis, so those forces act on the whole vehicle's mass; along the
+//! suspension the unsprung mass moves on its own and only the spring-damper force reaches the
+//! chassis. This is the exact mass matrix of that system when every suspension axis is the
+//! chassis z axis, which is how vehicles are described here.
+
+use crate::spec::{Differential, VehicleSpec};
+use verti_core::Vec3;
+
+/// Standard gravity \[m/s²\] (Chrono: 9.81 along −Z).
+pub(crate) const GRAVITY: f64 = 9.81;
+
+/// Constants of one wheel, derived from the spec once.
+#[derive(Clone, Debug)]
+pub(crate) struct WheelModel {
+    /// Wheel centre at spring free length, body frame, relative to the centre of mass.
+    pub attach: Vec3,
+    /// Lateral position in the reference frame (for Ackermann).
+    pub y: f64,
+    /// x relative to the mean of the unsteered axles (for Ackermann).
+    pub ackermann_dx: f64,
+    pub steered: bool,
+    pub driven: bool,
+    pub radius: f64,
+    pub half_width: f64,
+    pub rim_depth: f64,
+    pub unsprung_mass: f64,
+    pub spring: f64,
+    pub damper: f64,
+    pub bump: f64,
+    pub rebound: f64,
+    pub stop: f64,
+    pub stop_damping: f64,
+    pub brake_torque: f64,
+    pub group: usize,
+    /// Low-speed damping of the transient slip \[N s/m\] (bristle damping).
+    pub slip_damping_long: f64,
+    pub slip_damping_lat: f64,
+    /// Nominal static load \[N\]: sets the fixed stiffness of the tyre at standstill.
+    pub nominal_load: f64,
+    /// Static compression of the spring with the vehicle at rest (see [`static_compressions`]).
+    pub static_compression: f64,
+}
+
+/// Wheels that share one spin degree of freedom (a track's side, or a locked differential).
+#[derive(Clone, Debug)]
+pub(crate) struct SpinGroup {
+    pub wheels: Vec<usize>,
+    pub inertia: f64,
+    /// Share of the engine torque.
+    pub drive_share: f64,
+    /// Side for skid steering (+1 left, −1 right, 0 mixed).
+    pub side: f64,
+    pub driven: bool,
+}
+
+/// The compiled vehicle: everything the internal step needs that does not change.
+#[derive(Clone, Debug)]
+pub(crate) struct Model {
+    /// The fixed internal step \[s\].
+    pub step: f64,
+    pub wheels: Vec<WheelModel>,
+    pub groups: Vec<SpinGroup>,
+    pub sprung_mass: f64,
+    pub total_mass: f64,
+    /// Chassis-only principal inertia and the composite (with unsprung masses) one.
+    pub chassis_inertia: Vec3,
+    pub inertia: Vec3,
+    /// Centre of mass in the reference frame.
+    pub com: Vec3,
+    /// Chassis collision points (body frame, about the centre of mass) and the collision box.
+    pub body_points: Vec<Vec3>,
+    pub box_center: Vec3,
+    pub box_half: Vec3,
+    pub body_stiffness: f64,
+    pub body_damping: f64,
+    /// Sliding speed below which body friction is regularised (viscous) \[m/s\].
+    pub friction_speed: f64,
+    /// Bounding radius of the vehicle around its centre of mass, plus a margin \[m\].
+    pub reach: f64,
+    pub driven_wheels: usize,
+    /// Distance from the first steered axle to the mean of the unsteered ones (Ackermann).
+    pub wheelbase: f64,
+}
+
+impl Model {
+    /// Compiles a validated `spec` for a world of the given scale.
+    pub fn compile(spec: &VehicleSpec, scale: f64) -> Model {
+        let com = Vec3::new(
+            spec.chassis.com[0],
+            spec.chassis.com[1],
+            spec.chassis.com[2],
+        );
+        let track_mass = spec.track.map_or(0.0, |t| 2.0 * t.track_mass);
+        let sprung_mass = spec.chassis.mass + track_mass;
+        let total_mass = sprung_mass
+            + spec
+                .axles
+                .iter()
+                .map(|a| 2.0 * a.wheel.unsprung_mass)
+                .sum::<f64>();
+        let comp = static_compressions(spec);
+        let steered_x: Vec<f64> = spec
+            .axles
+            .iter()
+            .filter(|a| !a.steered)
+            .map(|a| a.x)
+            .collect();
+        let x_rear = if steered_x.is_empty() {
+            0.0
+        } else {
+            steered_x.iter().sum::<f64>() / steered_x.len() as f64
+        };
+        let h = spec.internal_step;
+
+        let (groups, group_of) = spin_groups(spec);
+        let driven_wheels = spec.axles.iter().filter(|a| a.driven).count() * 2;
+
+        let mut wheels = Vec::with_capacity(spec.wheel_count());
+        let mut inertia = Vec3::new(
+            spec.chassis.inertia[0],
+            spec.chassis.inertia[1],
+            spec.chassis.inertia[2],
+        );
+        let mut reach: f64 = 0.0;
+        let per_wheel_load = total_mass * GRAVITY / spec.wheel_count() as f64;
+        for (k, ax) in spec.axles.iter().enumerate() {
+            for side in [1.0f64, -1.0] {
+                let w = wheels.len();
+                let attach = Vec3::new(ax.x, side * 0.5 * ax.track, ax.z) - com;
+                let mu = ax.wheel.unsprung_mass;
+                inertia += Vec3::new(
+                    mu * (attach.y.powi(2) + attach.z.powi(2)),
+                    mu * (attach.x.powi(2) + attach.z.powi(2)),
+                    mu * (attach.x.powi(2) + attach.y.powi(2)),
+                );
+                reach = reach.max(attach.norm() + ax.wheel.radius + 0.5 * ax.wheel.width);
+                let t = &spec.tyre;
+                // Bristle damping at critical-ish ratio 0.3 of the slip-spring against the
+                // wheel's spin inertia (longitudinal) and its share of the mass (lateral).
+                let k_long = t.dfx0 * per_wheel_load / t.relaxation_length;
+                let k_lat = t.dfy0 * per_wheel_load / t.relaxation_length;
+                let g = group_of[w];
+                let spin_mass =
+                    groups[g].inertia / groups[g].wheels.len() as f64 / ax.wheel.radius.powi(2);
+                let lat_mass = total_mass / spec.wheel_count() as f64;
+                let stop_damping = 2.0 * 0.5 * (ax.suspension.stop_stiffness * mu).sqrt();
+                wheels.push(WheelModel {
+                    attach,
+                    y: side * 0.5 * ax.track,
+                    ackermann_dx: ax.x - x_rear,
+                    steered: ax.steered,
+                    driven: ax.driven,
+                    radius: ax.wheel.radius,
+                    half_width: 0.5 * ax.wheel.width,
+                    rim_depth: ax.wheel.radius - ax.wheel.rim_radius,
+                    unsprung_mass: mu,
+                    spring: ax.suspension.stiffness,
+                    damper: ax.suspension.damping,
+                    bump: ax.suspension.bump_travel,
+                    rebound: ax.suspension.rebound_travel,
+                    stop: ax.suspension.stop_stiffness,
+                    stop_damping,
+                    brake_torque: ax.brake_torque,
+                    group: g,
+                    slip_damping_long: 0.6 * (k_long * spin_mass).sqrt(),
+                    slip_damping_lat: 0.6 * (k_lat * lat_mass).sqrt(),
+                    nominal_load: per_wheel_load,
+                    static_compression: comp[k],
+                });
+            }
+        }
+        // Chassis collision points: the 18 points of a 3x3x2 lattice on the collision box.
+        let bx = &spec.chassis.collision_box;
+        let box_center = Vec3::new(bx.center[0], bx.center[1], bx.center[2]) - com;
+        let box_half = Vec3::new(bx.size[0], bx.size[1], bx.size[2]) * 0.5;
+        let mut body_points = Vec::with_capacity(18);
+        for iz in [-1.0, 1.0] {
+            for ix in [-1.0, 0.0, 1.0] {
+                for iy in [-1.0, 0.0, 1.0] {
+                    let p =
+                        box_center + Vec3::new(ix * box_half.x, iy * box_half.y, iz * box_half.z);
+                    reach = reach.max(p.norm());
+                    body_points.push(p);
+                }
+            }
+        }
+        // Body contact stiffness: chassis contact mode at ω·h = 0.15 when a quarter of the mass
+        // rests on one point; damping ratio 0.5. Against obstacles it is 4x stiffer
+        // (ω·h = 0.3, see `contact::body`); against terrain many points rest at once (a
+        // rolled vehicle on its roof) and the softer value keeps that stable.
+        let omega_body = 0.15 / h;
+        let body_stiffness = 0.25 * total_mass * omega_body * omega_body;
+        let body_damping = 2.0 * 0.5 * (body_stiffness * 0.25 * total_mass).sqrt();
+        let reach = reach * 1.1 + 0.2 * scale;
+        let wheelbase = wheels
+            .iter()
+            .find(|w| w.steered)
+            .map_or(1.0, |w| w.ackermann_dx);
+        Model {
+            step: h,
+            wheels,
+            groups,
+            sprung_mass,
+            total_mass,
+            chassis_inertia: Vec3::new(
+                spec.chassis.inertia[0],
+                spec.chassis.inertia[1],
+                spec.chassis.inertia[2],
+            ),
+            inertia,
+            com,
+            body_points,
+            box_center,
+            box_half,
+            body_stiffness,
+            body_damping,
+            friction_speed: 0.05 * scale.sqrt(),
+            reach,
+            driven_wheels,
+            wheelbase,
+        }
+    }
+}
+
+/// Static spring compression per axle: a rigid chassis on the axle springs (heave and pitch),
+/// which is exact for two axles and the stiffness-weighted split for more.
+pub(crate) fn static_compressions(spec: &VehicleSpec) -> Vec<f64> {
+    let w = spec.chassis.mass * GRAVITY;
+    let xc = spec.chassis.com[0];
+    let (mut k0, mut k1, mut k2) = (0.0, 0.0, 0.0);
+    for ax in &spec.axles {
+        let k = 2.0 * ax.suspension.stiffness;
+        let dx = ax.x - xc;
+        k0 += k;
+        k1 += k * dx;
+        k2 += k * dx * dx;
+    }
+    // Solve [k0 k1; k1 k2] [z; θ] = [W; 0] with compression_i = z + θ·dx_i.
+    let det = k0 * k2 - k1 * k1;
+    let (z, th) = if det.abs() > 1e-12 * k0 * k2.max(1e-12) {
+        (w * k2 / det, -w * k1 / det)
+    } else {
+        (w / k0, 0.0)
+    };
+    spec.axles.iter().map(|ax| z + th * (ax.x - xc)).collect()
+}
+
+/// Spin groups (tracks tie a side; locked differentials tie axles and sides) and each wheel's
+/// group. Wheels are numbered axle by axle, left then right.
+fn spin_groups(spec: &VehicleSpec) -> (Vec<SpinGroup>, Vec<usize>) {
+    let mut group_of = vec![usize::MAX; spec.wheel_count()];
+    let mut groups: Vec<SpinGroup> = Vec::new();
+    let tracked = spec.is_tracked();
+    for (k, ax) in spec.axles.iter().enumerate() {
+        for (j, side) in [1.0f64, -1.0].into_iter().enumerate() {
+            let w = 2 * k + j;
+            let key = group_key(spec, tracked, w);
+            let existing = key.and_then(|key| {
+                groups
+                    .iter()
+                    .position(|g| group_key(spec, tracked, g.wheels[0]) == Some(key))
+            });
+            let g = match existing {
+                Some(g) => g,
+                None => {
+                    groups.push(SpinGroup {
+                        wheels: Vec::new(),
+                        inertia: 0.0,
+                        drive_share: 0.0,
+                        side,
+                        driven: false,
+                    });
+                    groups.len() - 1
+                }
+            };
+            let grp = &mut groups[g];
+            grp.wheels.push(w);
+            grp.inertia += ax.wheel.spin_inertia;
+            grp.driven |= ax.driven;
+            if grp.side != side {
+                grp.side = 0.0;
+            }
+            group_of[w] = g;
+        }
+    }
+    if let Some(tr) = &spec.track {
+        for g in &mut groups {
+            // the track's mass spins with its side at the road-wheel radius
+            let r = g
+                .wheels
+                .iter()
+                .map(|&w| spec.axles[w / 2].wheel.radius)
+                .sum::<f64>()
+                / g.wheels.len() as f64;
+            g.inertia += tr.track_mass * r * r;
+        }
+    }
+    let driven_wheels = spec.axles.iter().filter(|a| a.driven).count() * 2;
+    for g in &mut groups {
+        let driven_members = g
+            .wheels
+            .iter()
+            .filter(|&&w| spec.axles[w / 2].driven)
+            .count();
+        g.drive_share = driven_members as f64 / driven_wheels as f64;
+        g.driven = driven_members > 0;
+    }
+    (groups, group_of)
+}
+
+/// Key identifying which spin group a wheel joins (None = its own group).
+fn group_key(spec: &VehicleSpec, tracked: bool, w: usize) -> Option<usize> {
+    let ax = &spec.axles[w / 2];
+    let j = w % 2;
+    if tracked {
+        return Some(j);
+    }
+    if !ax.driven {
+        return None;
+    }
+    match (
+        spec.powertrain.axle_differential,
+        spec.powertrain.central_differential,
+    ) {
+        (Differential::Locked, Differential::Locked) => Some(100),
+        (Differential::Locked, Differential::Open) => Some(200 + w / 2),
+        _ => None,
+    }
+}

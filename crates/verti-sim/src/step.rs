@@ -1,0 +1,219 @@
+//! [`Sim::step`] and the internal step that orchestrates the stages.
+//!
+//! One internal step is semi-implicit (symplectic) Euler at a fixed step, with implicit parts
+//! that remove the stiff modes:
+//! 1. staggered wheel update: after the chassis step, each wheel's suspension velocity is solved
+//!    implicitly against its spring, damper, stops and tyre or soil stiffness, the contact
+//!    acting on the wheel's absolute motion (the wheel-hop mode is the stiffest in a vehicle);
+//! 2. per spin group, the spin and the tyres' longitudinal forces are solved together
+//!    (linearised slip curve), then Coulomb brakes exactly;
+//! 3. the transient slip relaxes implicitly (`friction::relax_slip`; see [`crate::tyre`]).
+//!
+//! Every shipped vehicle is stable at its `internal_step`: 5 ms at full scale (Verti-Bench's
+//! step), 2 ms for the 1/6 and 1/10 vehicles. Stability at those steps is what the validation
+//! tests and the soak exercise.
+//!
+//! The order of the stages, and of the wheels within them, is part of the engine's contract:
+//! the same inputs give bit-identical trajectories, and a wheel's soil contact sees the ruts
+//! the wheels before it left in the same step.
+
+use crate::contact::body::body_contacts;
+use crate::contact::wheel::wheel_contact;
+use crate::contact::{WheelContact, WheelKinematics};
+use crate::drivetrain::{self, SpinLoads};
+use crate::error::SimError;
+use crate::friction::{self, TyreForces};
+use crate::integrate::{self, Loads};
+use crate::model::{GRAVITY, WheelModel};
+use crate::sim::Sim;
+use crate::spec::MAX_WHEELS;
+use crate::state::{ContactInfo, Controls, SimState, WheelState};
+use crate::suspension::{self, AxisLoad, spring_force};
+use verti_core::{Quat, Vec3};
+
+impl Sim {
+    /// Advances `state` by `dt` seconds with `controls` held. The internal step is the largest
+    /// step not above `spec.internal_step` that divides `dt` evenly.
+    pub fn step(&self, state: &mut SimState, controls: Controls, dt: f64) -> Result<(), SimError> {
+        controls.validate()?;
+        if !(dt.is_finite() && dt > 0.0 && dt <= 10.0) {
+            return Err(SimError::InvalidStep(dt));
+        }
+        let scale = self.terrain.world.meta.scale;
+        state.check(scale)?;
+        let n = ((dt / self.model.step) - 1e-9).ceil().max(1.0) as usize;
+        let h = dt / n as f64;
+        state.controls = controls;
+        let t0 = state.time;
+        for k in 0..n {
+            self.substep(state, &controls, h);
+            state.time = t0 + (k + 1) as f64 * h;
+            // cheap guard so a blow-up cannot run away inside a long step
+            if !(state.position.x.abs() < 1e9
+                && state.position.y.abs() < 1e9
+                && state.position.z.abs() < 1e9)
+            {
+                break;
+            }
+        }
+        // per-wheel steer angles are outputs only: computed once per call, not per internal step
+        let turn_radius = drivetrain::turn_radius(&self.spec, &self.model, state.steer);
+        for (m, w) in self.model.wheels.iter().zip(state.wheels.iter_mut()) {
+            w.steer_angle = drivetrain::ackermann_angle(m, turn_radius);
+        }
+        state.check(scale)
+    }
+
+    /// One internal step: driver inputs, wheel forces, spins, body contacts, integration.
+    fn substep(&self, st: &mut SimState, ctl: &Controls, h: f64) {
+        let (spec, model, terrain) = (&self.spec, &self.model, &self.terrain);
+        let frame = Frame::of(st);
+        let gravity = Vec3::new(0.0, 0.0, -GRAVITY);
+
+        // ---- driver: steering, engine and gearbox ----
+        let turn_radius = drivetrain::steer(spec, model, st, ctl, h);
+        let wheel_torque = drivetrain::engine(spec, model, st, ctl.throttle);
+
+        // ---- wheels: contact, suspension, tyre forces (the longitudinal one waits for the
+        // spin solve) ----
+        let mut loads = Loads::gravity(gravity, model.sprung_mass);
+        let mut contacts = ContactInfo::default();
+        let mut spin_loads = SpinLoads::ZERO;
+        let mut axis_loads = [AxisLoad::default(); MAX_WHEELS];
+        let mut axles = [Vec3::ZERO; MAX_WHEELS];
+        let mut tyres = [TyreForces::default(); MAX_WHEELS];
+        let near = terrain.obstacles.near(st.position.x, st.position.y);
+        for (w, m) in model.wheels.iter().enumerate() {
+            let ws = st.wheels[w];
+            let kin = frame.wheel(st, m, &ws, turn_radius);
+            let soil_b = ws.soil_patch_b;
+            let contact = wheel_contact(terrain, &mut st.soil, &spec.tyre, m, soil_b, &kin, near);
+            let spring = spring_force(m, &ws);
+            let tyre = friction::tyre_forces(&spec.tyre, spec.scale, m, &ws, &contact, &kin, h);
+
+            // the spin gets rolling resistance and the soil pressure moment about the axle,
+            // the composite body everything else
+            let axle_moment = contact.soil_moment.dot(kin.axle);
+            spin_loads.add_wheel(m.group, tyre.roll_torque + axle_moment, &tyre.long);
+            let mut f_ext = gravity * m.unsprung_mass + contact.force;
+            if tyre.long.active {
+                f_ext += tyre.lat_force;
+            }
+            let soil_off_axle = contact.soil_moment - kin.axle * axle_moment;
+            let moments = (soil_off_axle, tyre.contact_moment);
+            let f_axis = loads.add_wheel(kin.arm, frame.up, f_ext, spring.force, moments);
+
+            axis_loads[w] = AxisLoad::new(kin.arm, f_axis, &spring, &contact);
+            axles[w] = kin.axle;
+            tyres[w] = tyre;
+            record_wheel(&mut st.wheels[w], &mut contacts, &contact, &tyre);
+        }
+
+        // ---- spin groups: drive, brakes (exact Coulomb), skid steering; then the
+        // longitudinal tyre forces at the new spins and the drive reactions ----
+        let reaction = drivetrain::solve_spins(spec, model, st, ctl, wheel_torque, &spin_loads, h);
+        for (w, m) in model.wheels.iter().enumerate() {
+            let long = &tyres[w].long;
+            if !long.active {
+                st.wheels[w].long_force = 0.0;
+                continue;
+            }
+            let fx = long.force_at(st.group_spin[m.group]);
+            let f_axis = loads.add_wheel_force(axis_loads[w].arm, frame.up, long.e_long * fx);
+            axis_loads[w].external += f_axis;
+            st.wheels[w].long_force = fx;
+        }
+        for (w, m) in model.wheels.iter().enumerate() {
+            loads.torque += axles[w] * reaction[m.group];
+            st.wheels[w].spin_rate = st.group_spin[m.group];
+        }
+
+        // ---- chassis body contacts ----
+        let mu_body = spec.chassis.friction;
+        body_contacts(terrain, model, mu_body, st, near, &mut loads, &mut contacts);
+
+        // ---- integration: chassis accelerations, the implicit wheel updates against them,
+        // then the chassis itself ----
+        let acc = integrate::accelerations(model, st, &loads);
+        let v = st.velocity;
+        for ((ws, m), load) in st.wheels.iter_mut().zip(&model.wheels).zip(&axis_loads) {
+            suspension::update_wheel(ws, m, load, &acc, v, frame.omega, frame.up, h);
+        }
+        for (ws, tyre) in st.wheels.iter_mut().zip(&tyres) {
+            friction::relax_slip(ws, tyre, &spec.tyre, h);
+        }
+        integrate::advance_chassis(model, st, &loads, &acc, h);
+        st.contacts = contacts;
+    }
+}
+
+/// The chassis attitude at the start of an internal step: its axes and angular velocity in
+/// the world frame.
+struct Frame {
+    q: Quat,
+    ex: Vec3,
+    ey: Vec3,
+    up: Vec3,
+    omega: Vec3,
+}
+
+impl Frame {
+    #[inline]
+    fn of(st: &SimState) -> Frame {
+        let q = st.orientation;
+        Frame {
+            q,
+            ex: q.rotate(Vec3::X),
+            ey: q.rotate(Vec3::Y),
+            up: q.rotate(Vec3::Z),
+            omega: q.rotate(st.omega),
+        }
+    }
+
+    /// Where wheel `m` (state `ws`) is and how it moves.
+    #[inline]
+    fn wheel(
+        &self,
+        st: &SimState,
+        m: &WheelModel,
+        ws: &WheelState,
+        turn_radius: f64,
+    ) -> WheelKinematics {
+        let (sin_steer, cos_steer) = drivetrain::ackermann_sin_cos(m, turn_radius);
+        let arm = self.q.rotate(m.attach + Vec3::Z * ws.compression);
+        WheelKinematics {
+            arm,
+            hub: st.position + arm,
+            axle: self.ex * (-sin_steer) + self.ey * cos_steer,
+            hub_velocity: st.velocity + self.omega.cross(arm) + self.up * ws.compression_rate,
+            up: self.up,
+            chassis_omega: self.omega,
+            spin: st.group_spin[m.group],
+        }
+    }
+}
+
+/// The wheel's outputs of this internal step, and its share of the contact summary.
+#[inline]
+fn record_wheel(
+    out: &mut WheelState,
+    contacts: &mut ContactInfo,
+    contact: &WheelContact,
+    tyre: &TyreForces,
+) {
+    let fz_total = contact.normal_load();
+    out.normal_force = fz_total;
+    out.lat_force = tyre.lat;
+    out.in_contact = fz_total > 0.0;
+    out.on_soil = contact.soil_nodes > 0;
+    out.touches_obstacle = contact.obstacle;
+    out.sinkage = contact.sinkage;
+    out.tyre_deflection = contact.depth;
+    if contact.soil_nodes > 0 {
+        out.soil_patch_b = contact.soil_b;
+    }
+    contacts.wheels_in_contact += u32::from(fz_total > 0.0);
+    contacts.wheels_on_soil += u32::from(contact.soil_nodes > 0);
+    contacts.wheel_obstacle_contacts += u32::from(contact.obstacle);
+    contacts.soil_nodes_in_contact += contact.soil_nodes;
+}
