@@ -3,7 +3,8 @@
 //! The benchmark around the simulator:
 //!
 //! * [`system`]: the [`MobilitySystem`] interface. Systems see an [`Observation`] and return an
-//!   [`Action`]; they never touch simulator internals.
+//!   [`Action`]; they never touch simulator internals. A [`SystemRegistry`] builds them by
+//!   name from typed [`Params`].
 //! * [`observation`]: ground-truth observations with lazily computed, heading-aligned map crops.
 //! * [`episode`]: one trial of one system on one task, with the paper's success and failure
 //!   rules (or the reference code's, with `Rules::VertiBench`).
@@ -20,4 +21,5 @@ pub mod system;
 
 pub use episode::{EpisodeConfig, Outcome, Rules, Termination, TrialResult, run_episode};
 pub use observation::{Crop, CropSpec, Observation};
-pub use system::{Action, MobilitySystem, TaskInfo};
+pub use system::{Action, MobilitySystem, SystemFactory, SystemInfo, SystemRegistry, TaskInfo};
+pub use verti_core::params::{ParamKind, ParamSpec, ParamValue, Params};
