@@ -158,7 +158,11 @@ def test_vehicles_and_systems():
     names = [s["name"] for s in verti.systems()]
     assert names == ["pid", "eh", "mppi"]
     pid = verti.systems()[0]
-    assert any(p["name"] == "speed" for p in pid["params"])
+    speed = next(p for p in pid["params"] if p["name"] == "speed")
+    assert speed["type"] == "float" and speed["default"] == 3.0 and speed["max"] == 30.0
+    mppi = verti.systems()[2]
+    samples = next(p for p in mppi["params"] if p["name"] == "samples")
+    assert samples["type"] == "int" and samples["default"] == 800
 
 
 def test_world_errors_have_rust_messages(tmp_path):
@@ -204,8 +208,12 @@ def test_evaluate_writes_a_resumable_results_folder(world, tmp_path):
 def test_evaluate_rejects_bad_arguments(world):
     with pytest.raises(ValueError, match="unknown system `nope`"):
         verti.evaluate("nope", [world])
-    with pytest.raises(ValueError, match="pid parameter speed = 100"):
+    with pytest.raises(ValueError, match=r"pid parameter speed: 100 is outside \[0.1, 30\]"):
         verti.evaluate("pid", [world], params={"speed": 100.0})
+    with pytest.raises(ValueError, match="mppi parameter samples: `1.5` is not an integer"):
+        verti.evaluate("mppi", [world], params={"samples": 1.5})
+    with pytest.raises(ValueError, match="pid parameter kp: expected float, got `fast`"):
+        verti.evaluate("pid", [world], params={"kp": "fast"})
     with pytest.raises(ValueError, match="not in this world set"):
         verti.evaluate("pid", [world], tasks=[500])
     with pytest.raises(ValueError, match="bad task range"):

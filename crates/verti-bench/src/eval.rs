@@ -88,8 +88,10 @@ pub fn parse_tasks(spec: &str) -> Result<Vec<u32>, EvalError> {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunInfo {
     pub system: String,
-    /// System parameters as given (name = value).
-    pub params: Vec<(String, f64)>,
+    /// Every parameter of the system (defaults included), resolved by its registry. Older
+    /// `run.json` files hold only the parameters given, as `[name, number]` pairs; they still
+    /// resume (see [`RunInfo::same_run`]).
+    pub params: verti_core::params::Params,
     pub vehicle: String,
     pub worlds: String,
     /// World scale the set was generated or imported at.
@@ -97,6 +99,19 @@ pub struct RunInfo {
     pub rules: crate::episode::Rules,
     pub seed: u64,
     pub max_time: f64,
+}
+
+impl RunInfo {
+    /// Whether `recorded` (read from `run.json`) describes this run: every field equal, and
+    /// the recorded parameters, taken at their declared types with missing ones at their
+    /// defaults, equal to these.
+    pub fn same_run(&self, recorded: &RunInfo) -> bool {
+        let bare = |r: &RunInfo| RunInfo {
+            params: Default::default(),
+            ..r.clone()
+        };
+        bare(self) == bare(recorded) && self.params.same_as_recorded(&recorded.params)
+    }
 }
 
 /// Resolves the selected task numbers against a set: all tasks of the set when `selection` is
@@ -229,11 +244,12 @@ pub fn evaluate(
             line: 1,
             problem: e.to_string(),
         })?;
-        if before != setup.run {
+        if !setup.run.same_run(&before) {
             return Err(EvalError::Argument(format!(
-                "cannot resume: {} was made with different settings ({before:?}), now {:?}",
+                "cannot resume: {} was made with different settings ({}), now {}",
                 run_path.display(),
-                setup.run
+                serde_json::to_string(&before).expect("run info serialises"),
+                serde_json::to_string(&setup.run).expect("run info serialises"),
             )));
         }
         let (rs, clean) = read_results(&results_path)?;

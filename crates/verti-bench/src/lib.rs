@@ -3,7 +3,8 @@
 //! The benchmark around the simulator:
 //!
 //! * [`system`]: the [`MobilitySystem`] interface. Systems see an [`Observation`] and return an
-//!   [`Action`]; they never touch simulator internals.
+//!   [`Action`]; they never touch simulator internals. A [`SystemRegistry`] builds them by
+//!   name from typed [`Params`].
 //! * [`observation`]: ground-truth observations with lazily computed, heading-aligned map crops.
 //! * [`trial`]: [`Trial`], one vehicle on one task as one value that is stepped, cloned
 //!   (branched) and finished; the only place the inner loop (speed controller, physics,
@@ -29,5 +30,6 @@ pub mod trial;
 pub use episode::{EpisodeConfig, Outcome, Rules, Termination, TrialResult, run_episode};
 pub use features::{Feature, FeatureSource};
 pub use observation::{Crop, CropSpec, Observation};
-pub use system::{Action, MobilitySystem, TaskInfo};
+pub use system::{Action, MobilitySystem, SystemFactory, SystemInfo, SystemRegistry, TaskInfo};
 pub use trial::{StepOutcome, Trial, pose6, task_info};
+pub use verti_core::params::{ParamKind, ParamSpec, ParamValue, Params};

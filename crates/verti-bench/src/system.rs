@@ -1,6 +1,8 @@
-//! The interface between the benchmark and a mobility system.
+//! The interface between the benchmark and a mobility system, and the registry that builds
+//! systems by name.
 
 use crate::observation::Observation;
+use verti_core::registry::{Factory, FactoryInfo, Registrable, Registry};
 use verti_sim::Controls;
 use verti_world::TaskId;
 
@@ -46,3 +48,22 @@ pub trait MobilitySystem: Send {
     /// Called at the control rate; the action is held until the next call.
     fn act(&mut self, obs: &Observation) -> Action;
 }
+
+impl Registrable for dyn MobilitySystem {
+    const WHAT: &'static str = "system";
+}
+
+/// Mobility systems by name, with typed parameters (`verti systems list`). The command line
+/// and the Python module compose one from every crate's `register` function (PID, EH and MPPI:
+/// `verti_systems::register`), so a crate above verti-systems adds its systems there.
+pub type SystemRegistry = Registry<dyn MobilitySystem>;
+
+/// A system's name, summary and parameter declarations.
+pub type SystemInfo = FactoryInfo;
+
+/// Builds one mobility system from resolved parameters. Implement it as
+/// `impl Factory<dyn MobilitySystem> for MyFactory { fn info(..); fn build(..) }` (every such
+/// factory is a `SystemFactory`) and add it with [`SystemRegistry::register`].
+pub trait SystemFactory: Factory<dyn MobilitySystem> {}
+
+impl<F: Factory<dyn MobilitySystem> + ?Sized> SystemFactory for F {}

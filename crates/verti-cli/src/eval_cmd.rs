@@ -12,27 +12,17 @@ use verti_bench::{EpisodeConfig, run_episode};
 use verti_world::World;
 
 pub fn systems_list() -> CmdResult {
-    for s in verti_systems::list() {
-        println!("{}  {}", s.name, s.summary);
-        for p in &s.params {
-            println!(
-                "    {:<15} {:>8}   [{}, {}]  {}",
-                p.name, p.default, p.min, p.max, p.doc
-            );
-        }
-    }
+    crate::registries::print_list(crate::registries::systems().list());
     Ok(())
 }
 
-fn parse_param(s: &str) -> Result<(String, f64), String> {
-    let (k, v) = s
-        .split_once('=')
-        .ok_or_else(|| format!("parameter `{s}` must look like name=value"))?;
-    let v: f64 = v
-        .trim()
-        .parse()
-        .map_err(|_| format!("parameter `{s}`: `{v}` is not a number"))?;
-    Ok((k.trim().to_string(), v))
+/// `name=value`; the value is read per the parameter's declared type once the system is known.
+pub fn assignment(s: &str) -> Result<String, String> {
+    if s.contains('=') {
+        Ok(s.to_string())
+    } else {
+        Err(format!("parameter `{s}` must look like name=value"))
+    }
 }
 
 fn parse_rules(s: &str) -> Result<Rules, String> {
@@ -48,9 +38,9 @@ pub struct EvalArgs {
     /// Mobility system (see `verti systems list`).
     #[arg(long, default_value = "pid")]
     system: String,
-    /// System parameter override, name=value (repeatable).
-    #[arg(long = "param", value_parser = parse_param)]
-    params: Vec<(String, f64)>,
+    /// System parameter override, name=value (repeatable); see `verti systems list`.
+    #[arg(long = "param", value_parser = assignment)]
+    params: Vec<String>,
     /// World set: verti-100 (built-in), a set directory, or a folder of Verti-Bench worlds.
     #[arg(long, default_value = "verti-100")]
     worlds: String,
@@ -102,7 +92,15 @@ fn default_vehicle(scale: f64) -> &'static str {
 }
 
 pub fn eval(a: EvalArgs) -> CmdResult {
-    verti_systems::registry::resolve_params(&a.system, &a.params)?;
+    let registry = crate::registries::systems();
+    let given = a
+        .params
+        .iter()
+        .map(|p| registry.parse_param(&a.system, p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let params = registry.resolve(&a.system, &given)?;
+    // build one up front so that a system that cannot be built fails before any work
+    registry.build(&a.system, &params)?;
     let selection = parse_tasks(&a.tasks)?;
     let vehicle_name = a
         .vehicle
@@ -131,7 +129,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         force: a.force,
         run: RunInfo {
             system: a.system.clone(),
-            params: a.params.clone(),
+            params: params.clone(),
             vehicle: vehicle.name.clone(),
             worlds: a.worlds.clone(),
             scale: a.scale.scale,
@@ -163,9 +161,11 @@ pub fn eval(a: EvalArgs) -> CmdResult {
     };
     let total = verti_bench::eval::select_tasks(&worlds, &selection)?.len();
     let pb = bar(total as u64, &a.system);
-    let system = a.system.clone();
-    let params = a.params.clone();
-    let make = move || verti_systems::create(&system, &params).expect("parameters were checked");
+    let make = || {
+        registry
+            .build(&a.system, &params)
+            .expect("the system was built once already")
+    };
     let t0 = std::time::Instant::now();
     let results = evaluate(&setup, &selection, &make, &|_| pb.inc(1))?;
     pb.finish_and_clear();
@@ -246,7 +246,7 @@ pub fn replay(a: ReplayArgs) -> CmdResult {
         &format!("{}:{}", run.worlds, id.world),
         run.scale,
     )?);
-    let mut system = verti_systems::create(&run.system, &run.params)?;
+    let mut system = crate::registries::systems().build(&run.system, &run.params)?;
     let cfg = EpisodeConfig {
         rules: run.rules,
         max_time: run.max_time,

@@ -2,6 +2,7 @@
 
 mod eval_cmd;
 mod progress;
+mod registries;
 mod vehicle_cmd;
 mod world_cmd;
 

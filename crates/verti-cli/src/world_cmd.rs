@@ -5,7 +5,8 @@ use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use verti_world::format::{save_set, save_world};
-use verti_world::generate::{SetConfig, generate_set, set_name};
+use verti_world::generate::sources::DEFAULT_SOURCE;
+use verti_world::generate::{SetConfig, generate_set_with, set_name};
 use verti_world::import_vb::{ImportOptions, import_vb, scan_vb_dir};
 use verti_world::paths::DEFAULT_CLEARANCE;
 use verti_world::scale::parse_scale;
@@ -26,6 +27,8 @@ pub enum WorldCommand {
     Render(RenderArgs),
     /// Statistics of a world set: composition, elevation histograms, frictions, obstacles, paths.
     Stats(StatsArgs),
+    /// List the elevation sources `generate --elevation` can use, with their parameters.
+    Sources,
 }
 
 #[derive(Args)]
@@ -86,6 +89,12 @@ pub struct GenerateArgs {
     /// Clearance global paths keep from obstacles, full-scale metres (scaled with the world).
     #[arg(long, default_value_t = DEFAULT_CLEARANCE)]
     clearance: f64,
+    /// Elevation source (see `verti world sources`).
+    #[arg(long, default_value = DEFAULT_SOURCE)]
+    elevation: String,
+    /// Elevation source parameter, name=value (repeatable).
+    #[arg(long = "elevation-param", value_parser = crate::eval_cmd::assignment)]
+    elevation_params: Vec<String>,
     /// Output directory (default: worlds/<set name>).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -135,6 +144,10 @@ pub fn run(cmd: WorldCommand) -> CmdResult {
         WorldCommand::Show(a) => show(a),
         WorldCommand::Render(a) => render(a),
         WorldCommand::Stats(a) => stats(a),
+        WorldCommand::Sources => {
+            crate::registries::print_list(crate::registries::elevation_sources().list());
+            Ok(())
+        }
     }
 }
 
@@ -166,12 +179,27 @@ fn generate(a: GenerateArgs) -> CmdResult {
         clearance: a.clearance,
     };
     config.validate()?;
-    let name = set_name(&config);
+    let sources = crate::registries::elevation_sources();
+    let given = a
+        .elevation_params
+        .iter()
+        .map(|p| sources.parse_param(&a.elevation, p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let source = sources.create(&a.elevation, &given)?;
+    // sets from other sources or settings get their own names (each world's manifest records
+    // the source's full name, settings included)
+    let mut name = set_name(&config);
+    if a.elevation != DEFAULT_SOURCE {
+        name.push_str(&format!("-{}", a.elevation));
+    }
+    if !given.is_empty() {
+        name.push_str("-custom");
+    }
     let out = a.out.unwrap_or_else(|| PathBuf::from("worlds").join(&name));
     check_out_dir(&out, a.force)?;
     let t0 = Instant::now();
     let pb = bar(u64::from(a.count), "generating");
-    let worlds = generate_set(&config, &|| pb.inc(1))?;
+    let worlds = generate_set_with(&config, source.as_ref(), &|| pb.inc(1))?;
     pb.finish_and_clear();
     let t_gen = t0.elapsed();
     let pb = bar(u64::from(a.count), "writing");

@@ -147,7 +147,56 @@ fn bad_input_gets_clear_errors() {
     ]);
     assert!(e.contains("hovercraft") && e.contains("hmmwv"), "{e}");
     let e = run_err(&["eval", "--param", "speed=fast"]);
-    assert!(e.contains("speed=fast"), "{e}");
+    assert!(
+        e.contains("system pid parameter speed: `fast` is not a number"),
+        "{e}"
+    );
+    let e = run_err(&["eval", "--system", "mppi", "--param", "samples=0"]);
+    assert!(
+        e.contains("system mppi parameter samples: 0 is outside [1, 65536]"),
+        "{e}"
+    );
+    let e = run_err(&["eval", "--param", "speed"]);
+    assert!(e.contains("must look like name=value"), "{e}");
+    let e = run_err(&["world", "generate", "--elevation", "swae"]);
+    assert!(
+        e.contains("unknown elevation source `swae`; known: procedural-rock"),
+        "{e}"
+    );
+    let e = run_err(&["world", "generate", "--elevation-param", "pits_min=many"]);
+    assert!(
+        e.contains("parameter pits_min: `many` is not an integer"),
+        "{e}"
+    );
+    // the listings show each parameter's type, default and accepted values
+    let list = run_ok(&["systems", "list"]);
+    assert!(
+        list.lines()
+            .any(|l| l.contains("samples") && l.contains("int") && l.contains("800")),
+        "{list}"
+    );
+    let list = run_ok(&["world", "sources"]);
+    assert!(
+        list.contains("procedural-rock") && list.contains("coverage"),
+        "{list}"
+    );
+    // a source with other settings records them in each world's generator name
+    let dir = tmp("custom-source");
+    run_ok(&[
+        "world",
+        "generate",
+        "--count",
+        "1",
+        "--elevation-param",
+        "coverage=1.25",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let manifest = std::fs::read_to_string(dir.join("world-001/world.yaml")).unwrap();
+    assert!(
+        manifest.contains("procedural-rock-v1(coverage=1.25)"),
+        "{manifest}"
+    );
     let e = run_err(&[
         "world",
         "generate",

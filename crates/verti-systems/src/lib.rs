@@ -7,12 +7,16 @@
 //!   heading error, at 3 m/s.
 //! * [`eh::ElevationHeuristic`]: like PID, but blends in the direction of the region ahead
 //!   whose elevation is most like the ground under the vehicle and least rough.
-//! * [`mppi::Mppi`]: model-predictive path integral control with a kinematic bicycle model and
-//!   obstacle avoidance, the cost accumulated over the whole horizon.
+//! * [`mppi::Mppi`]: model-predictive path integral control over a pluggable
+//!   [`rollout::RolloutModel`] and [`rollout::RolloutCost`]; by default a kinematic bicycle
+//!   model and obstacle avoidance, the cost accumulated over the whole horizon.
 //!
 //! All speeds and distances are given at full scale and scaled with the world: lengths by the
 //! world scale s, speeds by √s (Froude similarity, so a 1/10-scale vehicle drives the 1/10
 //! world with the same dynamics as the full-scale one drives the full world).
+//!
+//! [`register`] adds PID, EH and MPPI to a `verti_bench::SystemRegistry`; the command line
+//! and the Python module compose their registry from it and from the crates above this one.
 
 pub mod eh;
 pub mod mppi;
@@ -20,5 +24,6 @@ pub mod mppi;
 pub use verti_bench::path;
 pub mod pid;
 pub mod registry;
+pub mod rollout;
 
-pub use registry::{ParamInfo, SystemInfo, create, list};
+pub use registry::{builtin, create, list, register};

@@ -1,14 +1,20 @@
 //! MPPI (paper §IV-A; reference constants spec §6.3): sample K steering/speed sequences around
-//! the previous plan, roll each out with a kinematic bicycle model, weight them by
-//! exp(−(cost − min cost)/λ), and average. Unlike the reference, the cost is accumulated over
-//! the whole horizon (not only the last step) and the rollout heading is integrated.
+//! the previous plan, roll them out with a [`RolloutModel`], score them with a
+//! [`RolloutCost`], weight them by exp(−(cost − min cost)/λ), and average.
 //!
-//! Cost per step: distance to the local goal (normalised by the distance at the start),
-//! a large penalty inside obstacles (read from a heading-aligned occupancy crop taken once
-//! per plan) or off the map, and a control term; plus a terminal distance term.
+//! The default model is a kinematic bicycle ([`Bicycle`]), the default cost [`PathCost`]: per
+//! step, distance to the local goal (normalised by the distance at the start), a large penalty
+//! inside obstacles or off the map, and a control term; plus a terminal distance term. Unlike
+//! the reference, the cost is accumulated over the whole horizon (not only the last step) and
+//! the rollout heading is integrated. Learned planners (TAL, TNT, WMVCT, MPPI-6, PIETRA, ...)
+//! are this MPPI with another model and cost: [`Mppi::with_model`].
 
 use crate::path::PathFollower;
-use verti_bench::{Action, CropSpec, MobilitySystem, Observation, TaskInfo};
+use crate::rollout::{
+    Bicycle, ControlSamples, PathCost, PathCostWeights, PlanContext, RolloutCost, RolloutModel,
+    Rollouts,
+};
+use verti_bench::{Action, MobilitySystem, Observation, TaskInfo};
 use verti_core::Rng;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -56,42 +62,59 @@ impl Default for MppiParams {
     }
 }
 
-/// A planar pose.
-#[derive(Clone, Copy, Debug)]
-struct Pose2 {
-    x: f64,
-    y: f64,
-    yaw: f64,
-}
-
+/// MPPI over a [`RolloutModel`] and a [`RolloutCost`] (by default the kinematic
+/// [`Bicycle`] and the [`PathCost`] weighted by the parameters' `w_*`).
 pub struct Mppi {
+    name: String,
     params: MppiParams,
+    model: Box<dyn RolloutModel>,
+    cost: Box<dyn RolloutCost>,
     follower: PathFollower,
     goal: [f64; 2],
     scale: f64,
-    wheelbase: f64,
-    max_steer: f64,
     /// Nominal plan: (speed, steering) per horizon step.
     plan: Vec<(f64, f64)>,
     rng: Rng,
-    // scratch buffers reused between plans
+    // buffers reused between plans
     noise: Vec<(f64, f64)>,
+    controls: Vec<(f64, f64)>,
+    rollouts: Rollouts,
     costs: Vec<f64>,
 }
 
 impl Mppi {
+    /// The MPPI of the paper: bicycle model, path cost.
     pub fn new(params: MppiParams) -> Self {
+        let cost = PathCost::new(PathCostWeights {
+            goal: params.w_goal,
+            obstacle: params.w_obstacle,
+            control: params.w_control,
+        });
+        Self::with_model("mppi", params, Box::new(Bicycle::default()), Box::new(cost))
+    }
+
+    /// MPPI with another rollout model and cost (the `w_*` weights of `params` are then
+    /// unused), reported under `name`.
+    pub fn with_model(
+        name: &str,
+        params: MppiParams,
+        model: Box<dyn RolloutModel>,
+        cost: Box<dyn RolloutCost>,
+    ) -> Self {
         let h = params.horizon;
         Mppi {
+            name: name.to_string(),
             params,
+            model,
+            cost,
             follower: PathFollower::default(),
             goal: [0.0; 2],
             scale: 1.0,
-            wheelbase: 3.4,
-            max_steer: 0.5,
             plan: vec![(0.0, 0.0); h],
             rng: Rng::new(0),
             noise: Vec::new(),
+            controls: Vec::new(),
+            rollouts: Rollouts::default(),
             costs: Vec::new(),
         }
     }
@@ -105,44 +128,25 @@ impl Mppi {
         let p = &self.params;
         let (k, h) = (p.samples.max(1), p.horizon.max(1));
         let v_nom = self.nominal_speed();
-        let local =
+        let local_goal =
             self.follower
                 .local_goal(obs.pose.x, obs.pose.y, p.lookahead * self.scale, self.goal);
-        let start = Pose2 {
-            x: obs.pose.x,
-            y: obs.pose.y,
-            yaw: obs.pose.yaw,
+        let (v_lo, v_hi) = (0.3 * v_nom, v_nom);
+        let sig_v = p.sigma_speed * self.scale.sqrt();
+        let ctx = PlanContext {
+            start: obs.pose,
+            local_goal,
+            samples: k,
+            horizon: h,
+            step: p.step,
+            nominal_speed: v_nom,
+            speed_range: (v_lo, v_hi),
+            lambda: p.lambda,
+            sigma: (sig_v, p.sigma_steer),
+            scale: self.scale,
         };
-        let d0 = ((local[0] - start.x).powi(2) + (local[1] - start.y).powi(2))
-            .sqrt()
-            .max(1e-3);
-        // occupancy crop covering the reachable area: radius v·T plus margin
-        let reach = v_nom * 1.5 * p.step * h as f64 + 2.0 * self.scale;
-        // obstacles are at least 3 m across: 0.4 m cells resolve them and keep the crop cheap
-        let res = 0.4 * self.scale;
-        let size = ((2.0 * reach / res).ceil() as usize) | 1;
-        let spec = CropSpec {
-            size,
-            resolution: res,
-        };
-        let occ = obs.occupancy_crop(spec);
-        let half = 0.5 * (size as f64 - 1.0);
-        let (sy, cy) = start.yaw.sin_cos();
-        let inv_res = 1.0 / res;
-        let max_index = 2.0 * half;
-        let occupied = |x: f64, y: f64| -> bool {
-            // world -> heading-aligned crop cell; rounding by +0.5 and truncation, because
-            // f64::round is a library call on baseline x86-64 and this runs ~50k times a plan
-            let (dx, dy) = (x - start.x, y - start.y);
-            let ahead = dx * cy + dy * sy;
-            let left = -dx * sy + dy * cy;
-            let r = half - ahead * inv_res + 0.5;
-            let c = half - left * inv_res + 0.5;
-            if r < 0.0 || c < 0.0 || r >= max_index + 1.0 || c >= max_index + 1.0 {
-                return false;
-            }
-            occ.get(r as usize, c as usize) != 0
-        };
+        self.model.prepare(obs, &ctx);
+        self.cost.prepare(obs, &ctx);
 
         // warm start: shift the previous plan by one step
         self.plan.rotate_left(1);
@@ -150,51 +154,31 @@ impl Mppi {
             *last = (v_nom, last.1);
         }
         self.noise.resize(k * h, (0.0, 0.0));
+        self.controls.resize(k * h, (0.0, 0.0));
         self.costs.resize(k, 0.0);
-        let sig_v = p.sigma_speed * self.scale.sqrt();
+        self.rollouts.resize(k, h);
         for n in self.noise.iter_mut() {
             let (a, b) = self.rng.normal_pair();
             *n = (sig_v * a, p.sigma_steer * b);
         }
-        let (v_lo, v_hi) = (0.3 * v_nom, v_nom);
-        // Rollouts use no trigonometry in the inner loop: the heading is carried as (cos, sin)
-        // and advanced by the rotation for the small per-step turn dψ (|dψ| < 0.1 rad), with
-        // series accurate to ~1e-8; tan of the steer angle (≤ ~0.7 rad) by its 7th-order series
-        // (error < 2e-3, far below what a kinematic bicycle model resolves).
-        let tan_series = |a: f64| {
-            let a2 = a * a;
-            a * (1.0 + a2 * (1.0 / 3.0 + a2 * (2.0 / 15.0 + a2 * (17.0 / 315.0))))
-        };
-        let inv_h = 1.0 / h as f64;
-        let inv_d0 = 1.0 / d0;
-        let ctrl_scale =
-            p.w_control * p.lambda / (p.sigma_steer * p.sigma_steer).max(1e-12) * inv_h;
-        let (c0, s0) = (start.yaw.cos(), start.yaw.sin());
         for s in 0..k {
-            let (mut x, mut y) = (start.x, start.y);
-            let (mut c, mut sn) = (c0, s0);
-            let mut cost = 0.0;
-            for t in 0..h {
-                let (nv, nd) = self.noise[s * h + t];
-                let (pv, pd) = self.plan[t];
-                let v = (pv + nv).clamp(v_lo, v_hi);
-                let d = (pd + nd).clamp(-1.0, 1.0);
-                let dpsi = v / self.wheelbase * tan_series(d * self.max_steer) * p.step;
-                let d2 = dpsi * dpsi;
-                let (cd, sd) = (1.0 - 0.5 * d2 + d2 * d2 / 24.0, dpsi * (1.0 - d2 / 6.0));
-                let (nc, ns) = (c * cd - sn * sd, sn * cd + c * sd);
-                c = nc;
-                sn = ns;
-                x += v * c * p.step;
-                y += v * sn * p.step;
-                let dist = ((local[0] - x).powi(2) + (local[1] - y).powi(2)).sqrt() * inv_d0;
-                cost += p.w_goal * dist * inv_h
-                    + if occupied(x, y) { p.w_obstacle } else { 0.0 }
-                    + ctrl_scale * (pd * nd).abs();
+            let noise = &self.noise[s * h..(s + 1) * h];
+            let u = &mut self.controls[s * h..(s + 1) * h];
+            for ((u, &(nv, nd)), &(pv, pd)) in u.iter_mut().zip(noise).zip(&self.plan) {
+                *u = ((pv + nv).clamp(v_lo, v_hi), (pd + nd).clamp(-1.0, 1.0));
             }
-            let dist = ((local[0] - x).powi(2) + (local[1] - y).powi(2)).sqrt() * inv_d0;
-            self.costs[s] = cost + p.w_goal * dist;
         }
+        let samples = ControlSamples {
+            samples: k,
+            horizon: h,
+            controls: &self.controls,
+            nominal: &self.plan,
+            noise: &self.noise,
+        };
+        self.model.rollout(&ctx, &samples, &mut self.rollouts);
+        self.cost
+            .evaluate(&ctx, &samples, &self.rollouts, &mut self.costs);
+
         let min = self.costs.iter().copied().fold(f64::INFINITY, f64::min);
         let mut total = 0.0;
         for c in self.costs.iter_mut() {
@@ -218,7 +202,7 @@ impl Mppi {
 
 impl MobilitySystem for Mppi {
     fn name(&self) -> &str {
-        "mppi"
+        &self.name
     }
     fn control_rate(&self) -> f64 {
         self.params.rate
@@ -227,8 +211,8 @@ impl MobilitySystem for Mppi {
         self.follower = PathFollower::new(task.global_path.clone());
         self.goal = task.goal;
         self.scale = task.world_scale;
-        self.wheelbase = task.wheelbase.max(1e-3);
-        self.max_steer = task.max_steer_angle.max(1e-3);
+        self.model.reset(task);
+        self.cost.reset(task);
         let v = self.nominal_speed();
         self.plan = vec![(v, 0.0); self.params.horizon.max(1)];
         self.rng = Rng::new(task.seed);

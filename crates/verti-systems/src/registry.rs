@@ -1,240 +1,236 @@
-//! Systems by name, with typed, documented parameters (`verti systems list`).
+//! The factories of PID, EH and MPPI, with typed, documented parameters
+//! (`verti systems list`). [`register`] adds them to a [`SystemRegistry`]; crates above this
+//! one register theirs next to them (see `verti_bench::SystemRegistry`).
 
 use crate::eh::{EhParams, ElevationHeuristic};
 use crate::mppi::{Mppi, MppiParams};
 use crate::pid::{Pid, PidParams};
-use verti_bench::MobilitySystem;
+use verti_bench::{MobilitySystem, ParamSpec, ParamValue, Params, SystemInfo, SystemRegistry};
+use verti_core::Factory;
 
-/// One tunable parameter.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ParamInfo {
-    pub name: &'static str,
-    pub default: f64,
-    /// Accepted range (inclusive).
-    pub min: f64,
-    pub max: f64,
-    pub doc: &'static str,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct SystemInfo {
-    pub name: &'static str,
-    pub summary: &'static str,
-    pub params: Vec<ParamInfo>,
-}
-
-fn p(name: &'static str, default: f64, min: f64, max: f64, doc: &'static str) -> ParamInfo {
-    ParamInfo {
-        name,
-        default,
-        min,
-        max,
-        doc,
-    }
-}
-
-fn pid_params() -> Vec<ParamInfo> {
+fn pid_params() -> Vec<ParamSpec> {
     let d = PidParams::default();
     vec![
-        p(
+        ParamSpec::float(
             "speed",
             d.speed,
             0.1,
             30.0,
             "target speed at full scale, m/s (scaled by sqrt(world scale))",
         ),
-        p(
+        ParamSpec::float(
             "lookahead",
             d.lookahead,
             0.5,
             60.0,
             "local goal distance along the global path at full scale, m",
         ),
-        p(
+        ParamSpec::float(
             "kp",
             d.kp,
             0.0,
             20.0,
             "road-wheel angle per radian of heading error",
         ),
-        p("ki", d.ki, 0.0, 20.0, "integral gain (per rad·s)"),
-        p("kd", d.kd, 0.0, 20.0, "derivative gain (per rad/s)"),
-        p("rate", d.rate, 1.0, 200.0, "control rate, Hz"),
+        ParamSpec::float("ki", d.ki, 0.0, 20.0, "integral gain (per rad·s)"),
+        ParamSpec::float("kd", d.kd, 0.0, 20.0, "derivative gain (per rad/s)"),
+        ParamSpec::float("rate", d.rate, 1.0, 200.0, "control rate, Hz"),
     ]
 }
 
-/// Every system with its parameters and defaults.
-pub fn list() -> Vec<SystemInfo> {
-    let m = MppiParams::default();
-    let mut eh = pid_params();
-    eh.push(p(
-        "terrain_weight",
-        EhParams::default().terrain_weight,
-        0.0,
-        1.0,
-        "weight of the terrain direction (path gets 1 - weight)",
-    ));
-    vec![
-        SystemInfo {
-            name: "pid",
-            summary: "path follower: local goal 10 m ahead, steering from heading error, 3 m/s",
-            params: pid_params(),
-        },
-        SystemInfo {
-            name: "eh",
-            summary: "elevation heuristic: PID blended toward the region ahead most like the current ground, least rough",
-            params: eh,
-        },
-        SystemInfo {
-            name: "mppi",
-            summary: "MPPI with a kinematic bicycle model and obstacle avoidance, cost over the whole horizon",
-            params: vec![
-                p(
-                    "samples",
-                    m.samples as f64,
-                    1.0,
-                    65536.0,
-                    "rollouts per plan",
-                ),
-                p("horizon", m.horizon as f64, 1.0, 1000.0, "rollout steps"),
-                p("step", m.step, 0.01, 1.0, "rollout step, s"),
-                p("lambda", m.lambda, 1e-4, 100.0, "temperature"),
-                p(
-                    "sigma_speed",
-                    m.sigma_speed,
-                    0.0,
-                    10.0,
-                    "speed noise at full scale, m/s",
-                ),
-                p(
-                    "sigma_steer",
-                    m.sigma_steer,
-                    0.0,
-                    2.0,
-                    "steering noise (normalised steering)",
-                ),
-                p(
-                    "speed",
-                    m.speed,
-                    0.1,
-                    30.0,
-                    "nominal speed at full scale, m/s",
-                ),
-                p(
-                    "lookahead",
-                    m.lookahead,
-                    0.5,
-                    60.0,
-                    "local goal distance at full scale, m",
-                ),
-                p(
-                    "w_goal",
-                    m.w_goal,
-                    0.0,
-                    1e6,
-                    "weight of the distance to the local goal",
-                ),
-                p(
-                    "w_obstacle",
-                    m.w_obstacle,
-                    0.0,
-                    1e6,
-                    "cost per rollout step inside an obstacle or off the map",
-                ),
-                p(
-                    "w_control",
-                    m.w_control,
-                    0.0,
-                    1e6,
-                    "weight of the control cost",
-                ),
-                p("rate", m.rate, 1.0, 200.0, "planning rate, Hz"),
-            ],
-        },
-    ]
-}
-
-/// Checks names and ranges; returns the full parameter vector with defaults filled in.
-pub fn resolve_params(
-    system: &str,
-    given: &[(String, f64)],
-) -> Result<Vec<(&'static str, f64)>, String> {
-    let info = list()
-        .into_iter()
-        .find(|s| s.name == system)
-        .ok_or_else(|| {
-            format!(
-                "unknown system `{system}`; known systems: {}",
-                list().iter().map(|s| s.name).collect::<Vec<_>>().join(", ")
-            )
-        })?;
-    let mut values: Vec<(&'static str, f64)> =
-        info.params.iter().map(|p| (p.name, p.default)).collect();
-    for (name, v) in given {
-        let Some(pi) = info.params.iter().find(|p| p.name == name) else {
-            return Err(format!(
-                "system {system} has no parameter `{name}`; its parameters: {}",
-                info.params
-                    .iter()
-                    .map(|p| p.name)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ));
-        };
-        if !(v.is_finite() && *v >= pi.min && *v <= pi.max) {
-            return Err(format!(
-                "{system} parameter {name} = {v} is outside [{}, {}]",
-                pi.min, pi.max
-            ));
-        }
-        values
-            .iter_mut()
-            .find(|(n, _)| n == name)
-            .expect("listed")
-            .1 = *v;
+fn pid_from(p: &Params) -> PidParams {
+    PidParams {
+        speed: p.float("speed"),
+        lookahead: p.float("lookahead"),
+        kp: p.float("kp"),
+        ki: p.float("ki"),
+        kd: p.float("kd"),
+        rate: p.float("rate"),
     }
-    Ok(values)
 }
 
-/// Builds a system by name. `params` override defaults.
-pub fn create(system: &str, params: &[(String, f64)]) -> Result<Box<dyn MobilitySystem>, String> {
-    let v = resolve_params(system, params)?;
-    let get = |n: &str| {
-        v.iter()
-            .find(|(k, _)| *k == n)
-            .map(|x| x.1)
-            .expect("resolved")
+/// PID path follower.
+pub struct PidFactory;
+
+impl Factory<dyn MobilitySystem> for PidFactory {
+    fn info(&self) -> SystemInfo {
+        SystemInfo {
+            name: "pid".into(),
+            summary: "path follower: local goal 10 m ahead, steering from heading error, 3 m/s"
+                .into(),
+            params: pid_params(),
+        }
+    }
+    fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
+        Ok(Box::new(Pid::new(pid_from(p))))
+    }
+}
+
+/// Elevation heuristic.
+pub struct EhFactory;
+
+impl Factory<dyn MobilitySystem> for EhFactory {
+    fn info(&self) -> SystemInfo {
+        let mut params = pid_params();
+        params.push(ParamSpec::float(
+            "terrain_weight",
+            EhParams::default().terrain_weight,
+            0.0,
+            1.0,
+            "weight of the terrain direction (path gets 1 - weight)",
+        ));
+        SystemInfo {
+            name: "eh".into(),
+            summary: "elevation heuristic: PID blended toward the region ahead most like the current ground, least rough".into(),
+            params,
+        }
+    }
+    fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
+        Ok(Box::new(ElevationHeuristic::new(EhParams {
+            pid: pid_from(p),
+            terrain_weight: p.float("terrain_weight"),
+        })))
+    }
+}
+
+/// The MPPI sampling parameters (`samples` .. `lambda`, `sigma_*`, `speed`, `lookahead`,
+/// `rate`), for systems built on [`Mppi`] with another model and cost; [`mppi_from`] reads
+/// them back.
+pub fn mppi_params() -> Vec<ParamSpec> {
+    let m = MppiParams::default();
+    vec![
+        ParamSpec::int("samples", m.samples as i64, 1, 65536, "rollouts per plan"),
+        ParamSpec::int("horizon", m.horizon as i64, 1, 1000, "rollout steps"),
+        ParamSpec::float("step", m.step, 0.01, 1.0, "rollout step, s"),
+        ParamSpec::float("lambda", m.lambda, 1e-4, 100.0, "temperature"),
+        ParamSpec::float(
+            "sigma_speed",
+            m.sigma_speed,
+            0.0,
+            10.0,
+            "speed noise at full scale, m/s",
+        ),
+        ParamSpec::float(
+            "sigma_steer",
+            m.sigma_steer,
+            0.0,
+            2.0,
+            "steering noise (normalised steering)",
+        ),
+        ParamSpec::float(
+            "speed",
+            m.speed,
+            0.1,
+            30.0,
+            "nominal speed at full scale, m/s",
+        ),
+        ParamSpec::float(
+            "lookahead",
+            m.lookahead,
+            0.5,
+            60.0,
+            "local goal distance at full scale, m",
+        ),
+        ParamSpec::float("rate", m.rate, 1.0, 200.0, "planning rate, Hz"),
+    ]
+}
+
+/// [`MppiParams`] from parameters declared by [`mppi_params`] (cost weights, when not
+/// declared, at their defaults).
+pub fn mppi_from(p: &Params) -> MppiParams {
+    let d = MppiParams::default();
+    let weight = |name: &str, default: f64| match p.get(name) {
+        Some(ParamValue::Float(w)) => *w,
+        _ => default,
     };
-    let pid = || PidParams {
-        speed: get("speed"),
-        lookahead: get("lookahead"),
-        kp: get("kp"),
-        ki: get("ki"),
-        kd: get("kd"),
-        rate: get("rate"),
-    };
-    Ok(match system {
-        "pid" => Box::new(Pid::new(pid())),
-        "eh" => Box::new(ElevationHeuristic::new(EhParams {
-            pid: pid(),
-            terrain_weight: get("terrain_weight"),
-        })),
-        "mppi" => Box::new(Mppi::new(MppiParams {
-            samples: get("samples") as usize,
-            horizon: get("horizon") as usize,
-            step: get("step"),
-            lambda: get("lambda"),
-            sigma_speed: get("sigma_speed"),
-            sigma_steer: get("sigma_steer"),
-            speed: get("speed"),
-            lookahead: get("lookahead"),
-            w_goal: get("w_goal"),
-            w_obstacle: get("w_obstacle"),
-            w_control: get("w_control"),
-            rate: get("rate"),
-        })),
-        _ => unreachable!("resolve_params checked the name"),
-    })
+    MppiParams {
+        samples: p.usize("samples"),
+        horizon: p.usize("horizon"),
+        step: p.float("step"),
+        lambda: p.float("lambda"),
+        sigma_speed: p.float("sigma_speed"),
+        sigma_steer: p.float("sigma_steer"),
+        speed: p.float("speed"),
+        lookahead: p.float("lookahead"),
+        w_goal: weight("w_goal", d.w_goal),
+        w_obstacle: weight("w_obstacle", d.w_obstacle),
+        w_control: weight("w_control", d.w_control),
+        rate: p.float("rate"),
+    }
+}
+
+/// MPPI with the kinematic bicycle model and the path cost.
+pub struct MppiFactory;
+
+impl Factory<dyn MobilitySystem> for MppiFactory {
+    fn info(&self) -> SystemInfo {
+        let m = MppiParams::default();
+        let mut params = mppi_params();
+        let rate = params.pop().expect("rate is last");
+        params.extend([
+            ParamSpec::float(
+                "w_goal",
+                m.w_goal,
+                0.0,
+                1e6,
+                "weight of the distance to the local goal",
+            ),
+            ParamSpec::float(
+                "w_obstacle",
+                m.w_obstacle,
+                0.0,
+                1e6,
+                "cost per rollout step inside an obstacle or off the map",
+            ),
+            ParamSpec::float(
+                "w_control",
+                m.w_control,
+                0.0,
+                1e6,
+                "weight of the control cost",
+            ),
+            rate,
+        ]);
+        SystemInfo {
+            name: "mppi".into(),
+            summary: "MPPI with a kinematic bicycle model and obstacle avoidance, cost over the whole horizon".into(),
+            params,
+        }
+    }
+    fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
+        Ok(Box::new(Mppi::new(mppi_from(p))))
+    }
+}
+
+/// Adds PID, EH and MPPI to a registry.
+pub fn register(registry: &mut SystemRegistry) {
+    for r in [
+        registry.register(PidFactory),
+        registry.register(EhFactory),
+        registry.register(MppiFactory),
+    ] {
+        r.expect("the built-in systems are declared correctly and registered once");
+    }
+}
+
+/// A registry of the built-in systems only (PID, EH, MPPI).
+pub fn builtin() -> SystemRegistry {
+    let mut r = SystemRegistry::new();
+    register(&mut r);
+    r
+}
+
+/// Every built-in system with its parameters and defaults.
+pub fn list() -> Vec<SystemInfo> {
+    builtin().list().cloned().collect()
+}
+
+/// Builds a built-in system by name; `params` override defaults.
+pub fn create(
+    system: &str,
+    params: &[(String, ParamValue)],
+) -> Result<Box<dyn MobilitySystem>, String> {
+    builtin().create(system, params).map_err(|e| e.to_string())
 }
 
 #[cfg(test)]
@@ -244,18 +240,45 @@ mod tests {
     #[test]
     fn builds_every_listed_system_and_rejects_bad_input() {
         for s in list() {
-            assert_eq!(create(s.name, &[]).unwrap().name(), s.name);
+            assert_eq!(create(&s.name, &[]).unwrap().name(), s.name);
         }
         let e = create("nope", &[]).err().unwrap();
         assert!(
             e.contains("unknown system `nope`") && e.contains("pid"),
             "{e}"
         );
-        let e = create("pid", &[("speeed".into(), 1.0)]).err().unwrap();
+        let e = create("pid", &[("speeed".into(), 1.0.into())])
+            .err()
+            .unwrap();
         assert!(e.contains("speeed") && e.contains("lookahead"), "{e}");
-        let e = create("mppi", &[("samples".into(), f64::NAN)])
+        let e = create("mppi", &[("samples".into(), f64::NAN.into())])
             .err()
             .unwrap();
         assert!(e.contains("samples"), "{e}");
+        let r = builtin();
+        let e = r
+            .parse_param("mppi", "samples=12.5")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("system mppi parameter samples"), "{e}");
+        let e = r.parse_param("mppi", "lambda=0").unwrap_err().to_string();
+        assert!(e.contains("lambda: 0 is outside [0.0001, 100]"), "{e}");
+    }
+
+    #[test]
+    fn typed_parameters_reach_the_system() {
+        let r = builtin();
+        let p = r
+            .resolve("mppi", &[r.parse_param("mppi", "samples=64").unwrap()])
+            .unwrap();
+        let m = mppi_from(&p);
+        assert_eq!((m.samples, m.horizon), (64, 30));
+        assert_eq!(
+            MppiParams {
+                samples: 800,
+                ..m.clone()
+            },
+            MppiParams::default()
+        );
     }
 }

@@ -49,7 +49,7 @@ fn setup<'a>(
         force: true,
         run: RunInfo {
             system: system.into(),
-            params: vec![],
+            params: verti_systems::builtin().resolve(system, &[]).unwrap(),
             vehicle: vehicle.name.clone(),
             worlds: "verti-2".into(),
             scale: 1.0,
@@ -84,8 +84,8 @@ fn results_are_identical_for_any_number_of_jobs() {
     let hmmwv = vehicles::builtin("hmmwv").unwrap();
     for system in ["pid", "mppi"] {
         // MPPI draws random samples: its per-task seed makes it deterministic too
-        let params: Vec<(String, f64)> = if system == "mppi" {
-            vec![("samples".into(), 64.0), ("horizon".into(), 20.0)]
+        let params: Vec<(String, verti_bench::ParamValue)> = if system == "mppi" {
+            vec![("samples".into(), 64.into()), ("horizon".into(), 20.into())]
         } else {
             vec![]
         };

@@ -86,28 +86,59 @@ pub(super) fn results_to_py(py: Python<'_>, results: &[TrialResult]) -> PyResult
         .collect()
 }
 
-/// System parameters: None, a dict name -> number, or a list of (name, number) pairs.
-pub(super) fn params_arg(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String, f64)>> {
+/// The systems Python can run: the built-in ones and those of crates above verti-systems.
+pub(super) fn system_registry() -> verti_bench::SystemRegistry {
+    let mut r = verti_bench::SystemRegistry::new();
+    verti_systems::register(&mut r);
+    r
+}
+
+/// One parameter value: bool, int, float, str or a path (`pathlib.Path`); checked against
+/// the declared type when resolved.
+pub(super) fn param_value(v: &Bound<'_, PyAny>) -> Option<ParamValue> {
+    if v.is_instance_of::<pyo3::types::PyBool>() {
+        return v.extract::<bool>().ok().map(ParamValue::Bool);
+    }
+    if let Ok(i) = v.extract::<i64>() {
+        return Some(ParamValue::Int(i));
+    }
+    if let Ok(x) = v.extract::<f64>() {
+        return Some(ParamValue::Float(x));
+    }
+    if let Ok(t) = v.extract::<String>() {
+        return Some(ParamValue::Str(t));
+    }
+    v.extract::<PathBuf>().ok().map(ParamValue::Path)
+}
+
+/// System parameters: None, a dict name -> value, or a list of (name, value) pairs.
+pub(super) fn params_arg(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String, ParamValue)>> {
     let Some(arg) = arg.filter(|a| !a.is_none()) else {
         return Ok(Vec::new());
     };
     let bad = || {
         PyTypeError::new_err(
-            "params must be a dict of parameter name -> number, e.g. {'speed': 4.0}",
+            "params must be a dict of parameter name -> value (number, bool, str or path), e.g. {'speed': 4.0}",
         )
     };
+    let pair = |k: &Bound<'_, PyAny>, v: &Bound<'_, PyAny>| {
+        Ok((
+            k.extract::<String>().map_err(|_| bad())?,
+            param_value(v).ok_or_else(bad)?,
+        ))
+    };
     if let Ok(d) = arg.cast::<PyDict>() {
-        return d
-            .iter()
-            .map(|(k, v)| {
-                Ok((
-                    k.extract::<String>().map_err(|_| bad())?,
-                    v.extract::<f64>().map_err(|_| bad())?,
-                ))
-            })
-            .collect();
+        return d.iter().map(|(k, v)| pair(&k, &v)).collect();
     }
-    arg.extract::<Vec<(String, f64)>>().map_err(|_| bad())
+    arg.try_iter()
+        .map_err(|_| bad())?
+        .map(|item| {
+            let (k, v) = item?
+                .extract::<(Bound<'_, PyAny>, Bound<'_, PyAny>)>()
+                .map_err(|_| bad())?;
+            pair(&k, &v)
+        })
+        .collect()
 }
 
 /// Runs `system` on the selected tasks, `jobs` trials at a time, and returns one dict per
@@ -157,9 +188,14 @@ pub(super) fn evaluate(
     }
     let system: String = system.extract()?;
     let system = system.as_str();
-    let params = params_arg(params)?;
+    let registry = system_registry();
+    let params = registry
+        .resolve(system, &params_arg(params)?)
+        .map_err(|e| value_err(e.to_string()))?;
     // build one system up front so unknown names and bad parameters fail before any work
-    verti_systems::create(system, &params).map_err(value_err)?;
+    registry
+        .build(system, &params)
+        .map_err(|e| value_err(e.to_string()))?;
     let spec = vehicle_spec(vehicle)?;
     let (worlds, worlds_name) = match worlds {
         Some(w) if !w.is_none() => worlds_arg(py, w, scale)?,
@@ -193,7 +229,7 @@ pub(super) fn evaluate(
                         if cancel.load(Ordering::Relaxed) {
                             return None;
                         }
-                        let inner = verti_systems::create(system, &params).expect("checked above");
+                        let inner = registry.build(system, &params).expect("checked above");
                         let mut sys = Cancellable {
                             inner,
                             cancel: &cancel,
@@ -244,7 +280,7 @@ pub(super) fn evaluate(
             step_log: None,
             cancel: Some(&cancel),
         };
-        let make = || verti_systems::create(system, &params).expect("checked above");
+        let make = || registry.build(system, &params).expect("checked above");
         all = interruptible(py, &cancel, || {
             verti_bench::eval::evaluate(&setup, chunk, &make, &|_| {})
         })?
@@ -255,28 +291,17 @@ pub(super) fn evaluate(
     results_to_py(py, &all)
 }
 
-/// The systems that `evaluate` knows, with their parameters.
+/// The systems that `evaluate` knows, with their parameters (name, type, default, min and
+/// max or choices, doc).
 #[pyfunction]
-pub(super) fn systems<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-    let out = PyList::empty(py);
-    for s in verti_systems::list() {
-        let d = PyDict::new(py);
-        d.set_item("name", s.name)?;
-        d.set_item("summary", s.summary)?;
-        let params = PyList::empty(py);
-        for p in s.params {
-            let pd = PyDict::new(py);
-            pd.set_item("name", p.name)?;
-            pd.set_item("default", p.default)?;
-            pd.set_item("min", p.min)?;
-            pd.set_item("max", p.max)?;
-            pd.set_item("doc", p.doc)?;
-            params.append(pd)?;
-        }
-        d.set_item("params", params)?;
-        out.append(d)?;
-    }
-    Ok(out)
+pub(super) fn systems(py: Python<'_>) -> PyResult<Py<PyAny>> {
+    let list: Vec<verti_bench::SystemInfo> = system_registry().list().cloned().collect();
+    let text = serde_json::to_string(&list).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    Ok(py
+        .import("json")?
+        .getattr("loads")?
+        .call1((text,))?
+        .unbind())
 }
 
 /// The settings of `evaluate` that do not depend on the kind of system.
@@ -361,7 +386,7 @@ fn evaluate_object(
     };
     let run = RunInfo {
         system: sys_spec.name.clone(),
-        params: vec![],
+        params: Default::default(),
         vehicle: spec.name.clone(),
         worlds: worlds_name,
         scale: worlds[0].meta.scale,

@@ -26,7 +26,7 @@ use verti_bench::eval::{EvalError, EvalSetup, RunInfo, parse_tasks, select_tasks
 use verti_bench::features::{ENV_STATE, Feature, FeatureSource, SIM_STATE, names_of};
 use verti_bench::observation::CropSpec;
 use verti_bench::pose6;
-use verti_bench::{Action, MobilitySystem, Observation, TaskInfo};
+use verti_bench::{Action, MobilitySystem, Observation, ParamValue, TaskInfo};
 use verti_env::{
     ActionMode, EnvConfig, EnvCore, EnvError, Episode, ObsBuf, RewardConfig, StepReport,
     TaskFilter, VecCore, encode_observation, outcome_code,

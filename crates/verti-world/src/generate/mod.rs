@@ -9,6 +9,7 @@
 pub mod elevation;
 pub mod obstacles;
 pub mod semantics;
+pub mod sources;
 
 use crate::error::{Result, WorldError};
 use crate::heightfield::Heightfield;
@@ -255,15 +256,24 @@ pub fn set_name(config: &SetConfig) -> String {
     name
 }
 
-/// Generates a whole set in parallel; `progress` is called once per finished world.
+/// Generates a whole set in parallel with the default elevation source; `progress` is called
+/// once per finished world.
 pub fn generate_set(config: &SetConfig, progress: &(dyn Fn() + Sync)) -> Result<Vec<World>> {
+    generate_set_with(config, &ProceduralRock::default(), progress)
+}
+
+/// [`generate_set`] with another elevation source (see [`sources`]).
+pub fn generate_set_with(
+    config: &SetConfig,
+    source: &dyn ElevationSource,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<World>> {
     config.validate()?;
     let comp = composition(config);
-    let source = ProceduralRock::default();
     comp.par_iter()
         .enumerate()
         .map(|(i, &(level, ty, density))| {
-            let w = generate_world(config, i as u32 + 1, level, ty, density, &source);
+            let w = generate_world(config, i as u32 + 1, level, ty, density, source);
             progress();
             w
         })

@@ -1,0 +1,42 @@
+//! The registries of the command line: every crate that provides mobility systems or
+//! elevation sources registers them here (a crate above verti-systems adds its `register`
+//! call next to the built-in ones).
+
+use verti_bench::SystemRegistry;
+use verti_world::generate::sources::ElevationRegistry;
+
+/// Every mobility system `verti` can run.
+pub fn systems() -> SystemRegistry {
+    let mut r = SystemRegistry::new();
+    verti_systems::register(&mut r);
+    r
+}
+
+/// Every elevation source `verti world generate` can use.
+pub fn elevation_sources() -> ElevationRegistry {
+    let mut r = ElevationRegistry::new();
+    verti_world::generate::sources::register(&mut r);
+    r
+}
+
+/// Prints each entry of a registry with its parameters: name, type, default, accepted values
+/// and doc.
+pub fn print_list<'a>(entries: impl Iterator<Item = &'a verti_core::FactoryInfo>) {
+    for s in entries {
+        println!("{}  {}", s.name, s.summary);
+        for p in &s.params {
+            let default = match p.default.to_string() {
+                d if d.is_empty() => "\"\"".to_string(),
+                d => d,
+            };
+            println!(
+                "    {:<15} {:<6} {:>9}   {:<16}  {}",
+                p.name,
+                p.kind.type_name(),
+                default,
+                p.kind.accepted(),
+                p.doc
+            );
+        }
+    }
+}
