@@ -1,0 +1,136 @@
+//! Loading: `results.jsonl` files, or directories holding them, read into trial results
+//! ([`load_results`], [`load_results_from`]).
+
+use crate::episode::TrialResult;
+use crate::eval::{EvalError, RESULTS_FILE, read_results};
+use std::path::{Path, PathBuf};
+
+/// Why results could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    #[error("{}: no such file or directory", .0.display())]
+    NotFound(PathBuf),
+    #[error(
+        "{}: no {RESULTS_FILE} in this directory or its immediate subdirectories",
+        .0.display()
+    )]
+    NoResults(PathBuf),
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// Reading or parsing a results file failed (the message names the file and line).
+    #[error(transparent)]
+    Eval(#[from] EvalError),
+}
+
+/// One results file that was read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadedFile {
+    pub path: PathBuf,
+    pub trials: usize,
+    /// `false` when a torn last line (a trial in flight when the run was killed) was dropped.
+    pub clean: bool,
+}
+
+/// Results and the files they came from.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Loaded {
+    pub results: Vec<TrialResult>,
+    pub files: Vec<LoadedFile>,
+}
+
+/// The results files a path stands for: a file itself; a directory's `results.jsonl`; or,
+/// for a directory without one (e.g. a folder of runs), the `results.jsonl` of each immediate
+/// subdirectory, sorted by name.
+fn result_files(path: &Path) -> Result<Vec<PathBuf>, ReportError> {
+    if path.is_file() {
+        return Ok(vec![path.to_path_buf()]);
+    }
+    if !path.is_dir() {
+        return Err(ReportError::NotFound(path.to_path_buf()));
+    }
+    let direct = path.join(RESULTS_FILE);
+    if direct.is_file() {
+        return Ok(vec![direct]);
+    }
+    let io = |source| ReportError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(path).map_err(io)? {
+        let f = entry.map_err(io)?.path().join(RESULTS_FILE);
+        if f.is_file() {
+            found.push(f);
+        }
+    }
+    if found.is_empty() {
+        return Err(ReportError::NoResults(path.to_path_buf()));
+    }
+    found.sort();
+    Ok(found)
+}
+
+/// Reads results from files (`.jsonl`) and result directories, in the order given, and says
+/// which files were read. A torn last line is dropped (and reported in [`LoadedFile::clean`]);
+/// any other unparsable line is an error naming the file and line.
+pub fn load_results_from(paths: &[PathBuf]) -> Result<Loaded, ReportError> {
+    let mut out = Loaded::default();
+    for p in paths {
+        for f in result_files(p)? {
+            let (results, clean) = read_results(&f)?;
+            out.files.push(LoadedFile {
+                path: f,
+                trials: results.len(),
+                clean,
+            });
+            out.results.extend(results);
+        }
+    }
+    Ok(out)
+}
+
+/// Reads results from files (`.jsonl`) and result directories (see [`load_results_from`]).
+pub fn load_results(paths: &[PathBuf]) -> Result<Vec<TrialResult>, ReportError> {
+    Ok(load_results_from(paths)?.results)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::fixtures::sample;
+
+    #[test]
+    fn load_results_reads_files_directories_and_names_bad_files() {
+        let dir = std::env::temp_dir().join(format!("verti-report-test-{}", std::process::id()));
+        let run = dir.join("runs").join("a");
+        std::fs::create_dir_all(&run).unwrap();
+        let lines: Vec<String> = sample()
+            .iter()
+            .map(|r| serde_json::to_string(r).unwrap())
+            .collect();
+        let file = run.join(RESULTS_FILE);
+        // a torn last line is dropped
+        std::fs::write(&file, format!("{}\n{}\n{{\"task\":", lines[0], lines[1])).unwrap();
+        let loaded = load_results_from(std::slice::from_ref(&run)).unwrap();
+        assert_eq!(loaded.results.len(), 2);
+        assert!(!loaded.files[0].clean);
+        // a folder of runs, and a file given directly
+        let all = load_results(&[dir.join("runs"), file.clone()]).unwrap();
+        assert_eq!(all.len(), 4);
+        // errors name the path
+        let e = load_results(&[dir.join("nope")]).unwrap_err().to_string();
+        assert!(e.contains("nope"), "{e}");
+        std::fs::create_dir_all(dir.join("empty")).unwrap();
+        let e = load_results(&[dir.join("empty")]).unwrap_err().to_string();
+        assert!(e.contains("empty") && e.contains(RESULTS_FILE), "{e}");
+        std::fs::write(&file, format!("garbage\n{}\n", lines[0])).unwrap();
+        let e = load_results(std::slice::from_ref(&file))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("results.jsonl") && e.contains("line 1"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
