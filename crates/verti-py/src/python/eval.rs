@@ -170,20 +170,20 @@ pub(super) fn evaluate(
         Some(s) if !s.is_none() => s,
         _ => default.as_any(),
     };
+    let setup = EvalArgs {
+        worlds,
+        tasks,
+        jobs,
+        vehicle,
+        rules,
+        max_time,
+        seed,
+        scale,
+        out,
+        resume,
+        force,
+    };
     if !system.is_instance_of::<PyString>() {
-        let setup = EvalArgs {
-            worlds,
-            tasks,
-            jobs,
-            vehicle,
-            rules,
-            max_time,
-            seed,
-            scale,
-            out,
-            resume,
-            force,
-        };
         return evaluate_object(py, system, params, setup);
     }
     let system: String = system.extract()?;
@@ -196,24 +196,18 @@ pub(super) fn evaluate(
     registry
         .build(system, &params)
         .map_err(|e| value_err(e.to_string()))?;
-    let spec = vehicle_spec(vehicle)?;
-    let (worlds, worlds_name) = match worlds {
-        Some(w) if !w.is_none() => worlds_arg(py, w, scale)?,
-        _ => worlds_arg(py, PyString::new(py, "verti-100").as_any(), scale)?,
-    };
-    let selection = tasks_arg(tasks)?;
     let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     if jobs == 0 {
         return Err(value_err("jobs must be at least 1".into()));
     }
-    let episode = EpisodeConfig {
-        rules: parse_rules(rules)?,
-        max_time,
-        seed,
-        ..Default::default()
-    };
-    episode.validate().map_err(value_err)?;
-    let selected = select_tasks(&worlds, &selection).map_err(eval_err)?;
+    let Prepared {
+        spec,
+        worlds,
+        worlds_name,
+        selected,
+        episode,
+    } = prepare(py, &setup)?;
+    let out = setup.out;
     let cancel = AtomicBool::new(false);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
@@ -319,6 +313,40 @@ pub(super) struct EvalArgs<'a, 'py> {
     force: bool,
 }
 
+/// What every evaluation resolves first: the vehicle, the worlds, the selected tasks and the
+/// rules, each checked with a clear error.
+struct Prepared {
+    spec: VehicleSpec,
+    worlds: Vec<Arc<World>>,
+    worlds_name: String,
+    selected: Vec<(usize, u32)>,
+    episode: EpisodeConfig,
+}
+
+fn prepare(py: Python<'_>, a: &EvalArgs<'_, '_>) -> PyResult<Prepared> {
+    let spec = vehicle_spec(a.vehicle)?;
+    let (worlds, worlds_name) = match a.worlds {
+        Some(w) if !w.is_none() => worlds_arg(py, w, a.scale)?,
+        _ => worlds_arg(py, PyString::new(py, "verti-100").as_any(), a.scale)?,
+    };
+    let selection = tasks_arg(a.tasks)?;
+    let episode = EpisodeConfig {
+        rules: parse_rules(a.rules)?,
+        max_time: a.max_time,
+        seed: a.seed,
+        ..Default::default()
+    };
+    episode.validate().map_err(value_err)?;
+    let selected = select_tasks(&worlds, &selection).map_err(eval_err)?;
+    Ok(Prepared {
+        spec,
+        worlds,
+        worlds_name,
+        selected,
+        episode,
+    })
+}
+
 /// `evaluate` with a Python object as the system: one trial at a time (the object is not
 /// shared between threads), through `run_episode` and, with `out`, the resumable runner.
 fn evaluate_object(
@@ -338,20 +366,13 @@ fn evaluate_object(
         ));
     }
     let sys_spec = PySystemSpec::of(object)?;
-    let spec = vehicle_spec(a.vehicle)?;
-    let (worlds, worlds_name) = match a.worlds {
-        Some(w) if !w.is_none() => worlds_arg(py, w, a.scale)?,
-        _ => worlds_arg(py, PyString::new(py, "verti-100").as_any(), a.scale)?,
-    };
-    let selection = tasks_arg(a.tasks)?;
-    let episode = EpisodeConfig {
-        rules: parse_rules(a.rules)?,
-        max_time: a.max_time,
-        seed: a.seed,
-        ..Default::default()
-    };
-    episode.validate().map_err(value_err)?;
-    let selected = select_tasks(&worlds, &selection).map_err(eval_err)?;
+    let Prepared {
+        spec,
+        worlds,
+        worlds_name,
+        selected,
+        episode,
+    } = prepare(py, &a)?;
     let raised: RaisedError = Arc::new(std::sync::Mutex::new(None));
     let cancel = Arc::new(AtomicBool::new(false));
     let object: Py<PyAny> = object.clone().unbind();
