@@ -212,6 +212,32 @@ pub struct EvalSetup<'a> {
     /// Raised to stop the run: trials that finish after it is raised are not recorded (they
     /// may have been cut short), and `evaluate` returns `EvalError::Cancelled`.
     pub cancel: Option<&'a AtomicBool>,
+    /// Told about anything repaired on the way (a torn last line dropped on resume).
+    pub warn: Option<&'a (dyn Fn(&str) + Sync)>,
+}
+
+/// Name of the lock file that keeps two runs out of one results directory.
+pub const LOCK_FILE: &str = ".lock";
+
+/// The most worker threads a run may ask for: a few per core is plenty for CPU-bound trials,
+/// and far more only thrashes the machine.
+pub fn max_jobs() -> usize {
+    4 * std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Checks a worker-thread count (`what` names the option in the message).
+pub fn check_jobs(jobs: usize, what: &str) -> Result<(), String> {
+    let max = max_jobs();
+    if jobs == 0 {
+        return Err(format!("{what} must be at least 1"));
+    }
+    if jobs > max {
+        return Err(format!(
+            "{what} {jobs} is too many: this machine has {} cores; use at most {max}",
+            max / 4
+        ));
+    }
+    Ok(())
 }
 
 /// Runs the selected tasks; returns all results of the run (earlier and new), sorted by task.
@@ -221,12 +247,29 @@ pub fn evaluate(
     make_system: &(dyn Fn() -> Box<dyn MobilitySystem> + Sync),
     on_result: &(dyn Fn(&TrialResult) + Sync),
 ) -> Result<Vec<TrialResult>, EvalError> {
-    if setup.jobs == 0 {
-        return Err(EvalError::Argument("--jobs must be at least 1".into()));
-    }
+    check_jobs(setup.jobs, "--jobs").map_err(EvalError::Argument)?;
     setup.episode.validate().map_err(EvalError::Argument)?;
     let tasks = select_tasks(setup.worlds, selection)?;
     std::fs::create_dir_all(&setup.out).map_err(io(&setup.out))?;
+    // one run at a time per directory: the lock is released when this function returns or the
+    // process dies (a killed run can be resumed at once)
+    let lock_path = setup.out.join(LOCK_FILE);
+    let lock = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&lock_path)
+        .map_err(io(&lock_path))?;
+    match lock.try_lock() {
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) => {
+            return Err(EvalError::Argument(format!(
+                "{} is in use by another running evaluation; wait for it to finish or choose another --out",
+                setup.out.display()
+            )));
+        }
+        Err(std::fs::TryLockError::Error(e)) => return Err(io(&lock_path)(e)),
+    }
     let results_path = setup.out.join(RESULTS_FILE);
     let run_path = setup.out.join(RUN_FILE);
 
@@ -253,8 +296,19 @@ pub fn evaluate(
             )));
         }
         let (rs, clean) = read_results(&results_path)?;
-        if !clean {
-            // rewrite without the torn line so appends start on a fresh line
+        let ends_in_newline = std::fs::read(&results_path)
+            .map_err(io(&results_path))?
+            .last()
+            .is_none_or(|b| *b == b'\n');
+        if !clean && let Some(warn) = setup.warn {
+            warn(&format!(
+                "{}: dropped a torn last line (a run killed while writing); that task runs again",
+                results_path.display()
+            ));
+        }
+        if !clean || !ends_in_newline {
+            // rewrite without the torn line, ending in a newline, so appends start on a fresh
+            // line instead of being glued to the last result
             let mut text = String::new();
             for r in &rs {
                 text.push_str(&serde_json::to_string(r).expect("results serialise"));

@@ -119,6 +119,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         seed: a.seed,
         ..Default::default()
     };
+    let warn = |m: &str| eprintln!("warning: {m}");
     let setup = EvalSetup {
         worlds: &worlds,
         vehicle: &vehicle,
@@ -139,6 +140,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         },
         step_log: None,
         cancel: None,
+        warn: Some(&warn),
     };
     let steps_dir = out.join("steps");
     let write_log = |r: &verti_bench::TrialResult, log: &EpisodeLog| {

@@ -57,8 +57,8 @@ fn main() -> ExitCode {
     }
     let cli = Cli::parse();
     if let Some(n) = cli.threads {
-        if n == 0 {
-            eprintln!("error: --threads must be at least 1");
+        if let Err(e) = verti_bench::eval::check_jobs(n, "--threads") {
+            eprintln!("error: {e}");
             return ExitCode::from(2);
         }
         // The global pool can only be built once; failing here means it already exists.

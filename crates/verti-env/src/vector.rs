@@ -33,6 +33,7 @@ pub struct VecCore {
 
 impl VecCore {
     pub fn new(template: EnvCore, n: usize, threads: usize) -> Result<VecCore, EnvError> {
+        verti_bench::eval::check_jobs(threads, "num_threads").map_err(EnvError::InvalidConfig)?;
         if n == 0 {
             return Err(EnvError::InvalidConfig(
                 "num_envs must be at least 1".into(),

@@ -59,6 +59,7 @@ fn setup<'a>(
         },
         step_log: None,
         cancel: None,
+        warn: None,
     }
 }
 
@@ -204,4 +205,97 @@ fn pid_reaches_goals_on_the_built_in_set() {
     assert_eq!(rs.len(), 30);
     assert!(rs.iter().all(|r| r.outcome != Outcome::Error));
     assert!(rs.iter().filter(|r| r.outcome == Outcome::Success).count() >= 5);
+}
+
+#[test]
+fn a_last_line_without_its_newline_is_not_glued_to_the_next_result_and_torn_lines_are_reported() {
+    let ws = worlds(1);
+    let hmmwv = vehicles::builtin("hmmwv").unwrap();
+    let make = || verti_systems::create("pid", &[]).unwrap();
+    let out = tmp("no-newline");
+    evaluate(
+        &setup(&ws, &hmmwv, out.clone(), 1, "pid"),
+        &parse_tasks("1-3").unwrap(),
+        &make,
+        &|_| {},
+    )
+    .unwrap();
+    // a complete last line whose newline was lost
+    let path = out.join(RESULTS_FILE);
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(&path, text.trim_end()).unwrap();
+    let warnings = std::sync::Mutex::new(Vec::<String>::new());
+    let warn = |m: &str| warnings.lock().unwrap().push(m.to_string());
+    let mut s = setup(&ws, &hmmwv, out.clone(), 1, "pid");
+    s.force = false;
+    s.resume = true;
+    s.warn = Some(&warn);
+    let all = evaluate(&s, &parse_tasks("1-5").unwrap(), &make, &|_| {}).unwrap();
+    assert_eq!(all.len(), 5);
+    let (on_disk, clean) = read_results(&path).unwrap();
+    assert!(clean && on_disk.len() == 5, "{} results", on_disk.len());
+    assert!(warnings.lock().unwrap().is_empty(), "nothing was torn");
+
+    // a torn line is dropped, and said so
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    text.push_str("{\"task\": 9");
+    std::fs::write(&path, text).unwrap();
+    evaluate(&s, &parse_tasks("1-5").unwrap(), &make, &|_| {}).unwrap();
+    let said = warnings.lock().unwrap().join("\n");
+    assert!(said.contains("torn last line"), "{said}");
+}
+
+#[test]
+fn two_runs_never_share_a_results_directory() {
+    let ws = worlds(1);
+    let hmmwv = vehicles::builtin("hmmwv").unwrap();
+    let make = || verti_systems::create("pid", &[]).unwrap();
+    let out = tmp("locked");
+    std::fs::create_dir_all(&out).unwrap();
+    // another run holds the directory
+    let other = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(out.join(verti_bench::eval::LOCK_FILE))
+        .unwrap();
+    other.lock().unwrap();
+    let e = evaluate(
+        &setup(&ws, &hmmwv, out.clone(), 1, "pid"),
+        &parse_tasks("1").unwrap(),
+        &make,
+        &|_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("in use by another running evaluation"), "{e}");
+    assert!(!out.join(RESULTS_FILE).exists(), "nothing was written");
+    // once it is gone (finished or killed), the directory is free
+    drop(other);
+    let r = evaluate(
+        &setup(&ws, &hmmwv, out.clone(), 1, "pid"),
+        &parse_tasks("1").unwrap(),
+        &make,
+        &|_| {},
+    )
+    .unwrap();
+    assert_eq!(r.len(), 1);
+}
+
+#[test]
+fn absurd_worker_counts_are_refused() {
+    let ws = worlds(1);
+    let hmmwv = vehicles::builtin("hmmwv").unwrap();
+    let make = || verti_systems::create("pid", &[]).unwrap();
+    let e = evaluate(
+        &setup(&ws, &hmmwv, tmp("jobs"), 10_000, "pid"),
+        &parse_tasks("1").unwrap(),
+        &make,
+        &|_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("--jobs 10000 is too many"), "{e}");
+    assert!(verti_bench::eval::check_jobs(verti_bench::eval::max_jobs(), "--jobs").is_ok());
+    assert!(verti_bench::eval::check_jobs(0, "--jobs").is_err());
 }

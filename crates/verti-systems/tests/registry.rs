@@ -176,6 +176,7 @@ fn setup<'a>(
         },
         step_log: None,
         cancel: None,
+        warn: None,
     }
 }
 

@@ -197,9 +197,7 @@ pub(super) fn evaluate(
         .build(system, &params)
         .map_err(|e| value_err(e.to_string()))?;
     let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    if jobs == 0 {
-        return Err(value_err("jobs must be at least 1".into()));
-    }
+    verti_bench::eval::check_jobs(jobs, "jobs").map_err(value_err)?;
     let Prepared {
         spec,
         worlds,
@@ -260,6 +258,13 @@ pub(super) fn evaluate(
         seed,
         max_time,
     };
+    let notes = std::sync::Mutex::new(Vec::new());
+    let note = |m: &str| {
+        notes
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .push(m.to_string())
+    };
     let mut all = Vec::new();
     for (k, chunk) in numbers.chunks((4 * jobs).max(16)).enumerate() {
         let setup = EvalSetup {
@@ -273,6 +278,7 @@ pub(super) fn evaluate(
             run: run.clone(),
             step_log: None,
             cancel: Some(&cancel),
+            warn: Some(&note),
         };
         let make = || registry.build(system, &params).expect("checked above");
         all = interruptible(py, &cancel, || {
@@ -280,6 +286,7 @@ pub(super) fn evaluate(
         })?
         .map_err(eval_err)?;
     }
+    warn_all(py, &notes)?;
     let wanted: std::collections::BTreeSet<u32> = numbers.into_iter().collect();
     all.retain(|r| wanted.contains(&r.task));
     results_to_py(py, &all)
@@ -415,6 +422,13 @@ fn evaluate_object(
         seed: a.seed,
         max_time: a.max_time,
     };
+    let notes = std::sync::Mutex::new(Vec::new());
+    let note = |m: &str| {
+        notes
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .push(m.to_string())
+    };
     let setup = EvalSetup {
         worlds: &worlds,
         vehicle: &spec,
@@ -426,6 +440,7 @@ fn evaluate_object(
         run,
         step_log: None,
         cancel: Some(&cancel),
+        warn: Some(&note),
     };
     let numbers: Vec<u32> = selected
         .iter()
@@ -438,7 +453,18 @@ fn evaluate_object(
         return Err(e);
     }
     let mut all = result.map_err(eval_err)?;
+    warn_all(py, &notes)?;
     let wanted: std::collections::BTreeSet<u32> = numbers.into_iter().collect();
     all.retain(|r| wanted.contains(&r.task));
     results_to_py(py, &all)
+}
+
+/// Passes the notes of a run (repairs made on the way) to Python's `warnings`.
+fn warn_all(py: Python<'_>, notes: &std::sync::Mutex<Vec<String>>) -> PyResult<()> {
+    let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+    for m in notes.lock().unwrap_or_else(|p| p.into_inner()).drain(..) {
+        let text = std::ffi::CString::new(m.replace('\0', " ")).expect("no NUL left");
+        PyErr::warn(py, &category, &text, 1)?;
+    }
+    Ok(())
 }
