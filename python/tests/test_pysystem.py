@@ -111,3 +111,16 @@ class WrongSize(Broken):
 def test_bad_actions_are_clear_errors(worlds):
     with pytest.raises(ValueError, match="expected 2"):
         verti.evaluate(WrongSize(), worlds, tasks=1)
+
+
+def test_arguments_that_used_to_mean_something_else_are_refused(worlds, tmp_path):
+    # issue 10: an empty selection is not "all", resume and force exclude each other, and
+    # worker counts are capped
+    with pytest.raises(ValueError, match="selects no task"):
+        verti.evaluate("pid", worlds, tasks=[])
+    with pytest.raises(ValueError, match="pass one of them"):
+        verti.evaluate("pid", worlds, tasks=1, out=str(tmp_path / "r"), resume=True, force=True)
+    with pytest.raises(ValueError, match="too many"):
+        verti.evaluate("pid", worlds, tasks=1, jobs=10_000)
+    with pytest.raises(ValueError, match="selects nothing"):
+        verti.NavigateEnv(worlds, levels=[])

@@ -36,6 +36,12 @@ pub(super) fn names_arg<T>(
             PyTypeError::new_err(format!("{what} must be a name or a list of names"))
         })?
     };
+    if names.is_empty() {
+        // an empty list would select nothing; "all" is spelled None
+        return Err(value_err(format!(
+            "an empty list of {what}s selects nothing; pass None for all (known: {known})"
+        )));
+    }
     names
         .iter()
         .map(|n| parse(n).ok_or_else(|| value_err(format!("unknown {what} `{n}`; known: {known}"))))

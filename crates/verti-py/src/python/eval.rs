@@ -59,6 +59,12 @@ pub(super) fn tasks_arg(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<u32>> {
             .ok_or_else(|| value_err(format!("task number {n} must be at least 1")));
     }
     let list: Vec<i64> = arg.extract().map_err(|_| PyTypeError::new_err("tasks must be None (all), a task number, a list of task numbers or a range string like '1-10,15'"))?;
+    if list.is_empty() {
+        // an empty list would select nothing; "all" is spelled None
+        return Err(value_err(
+            "tasks=[] selects no task; pass None for all tasks".into(),
+        ));
+    }
     let mut out = Vec::with_capacity(list.len());
     for n in list {
         out.push(
@@ -170,6 +176,12 @@ pub(super) fn evaluate(
         Some(s) if !s.is_none() => s,
         _ => default.as_any(),
     };
+    if resume && force {
+        return Err(value_err(
+            "resume=True continues the run in `out` and force=True discards it: pass one of them"
+                .into(),
+        ));
+    }
     let setup = EvalArgs {
         worlds,
         tasks,
