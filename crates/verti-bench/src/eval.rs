@@ -49,6 +49,39 @@ fn io(path: &Path) -> impl Fn(std::io::Error) -> EvalError + '_ {
     }
 }
 
+/// A task selection as the text `parse_tasks` reads back: `all` for none, else ranges like
+/// `1-60,75`.
+pub fn format_tasks(selection: &[u32]) -> String {
+    if selection.is_empty() {
+        return "all".into();
+    }
+    let mut sorted = selection.to_vec();
+    sorted.sort_unstable();
+    sorted.dedup();
+    let mut parts = Vec::new();
+    let mut start = sorted[0];
+    let mut end = start;
+    for &n in &sorted[1..] {
+        if n == end + 1 {
+            end = n;
+        } else {
+            parts.push(if start == end {
+                start.to_string()
+            } else {
+                format!("{start}-{end}")
+            });
+            start = n;
+            end = n;
+        }
+    }
+    parts.push(if start == end {
+        start.to_string()
+    } else {
+        format!("{start}-{end}")
+    });
+    parts.join(",")
+}
+
 /// Parses a task selection like `1-1000`, `7`, `1,5,10-20` or `all` into sorted task numbers.
 pub fn parse_tasks(spec: &str) -> Result<Vec<u32>, EvalError> {
     let bad = |why: String| EvalError::Argument(format!("bad task range `{spec}`: {why}"));
@@ -249,7 +282,11 @@ pub fn evaluate(
 ) -> Result<Vec<TrialResult>, EvalError> {
     check_jobs(setup.jobs, "--jobs").map_err(EvalError::Argument)?;
     setup.episode.validate().map_err(EvalError::Argument)?;
-    let tasks = select_tasks(setup.worlds, selection)?;
+    // checks the selection before anything is written
+    select_tasks(setup.worlds, selection)?;
+    // what this call runs, and what run.json records the run as covering
+    let mut selection = selection.to_vec();
+    let mut recorded_selection = selection.clone();
     std::fs::create_dir_all(&setup.out).map_err(io(&setup.out))?;
     // one run at a time per directory: the lock is released when this function returns or the
     // process dies (a killed run can be resumed at once)
@@ -287,6 +324,26 @@ pub fn evaluate(
             line: 1,
             problem: e.to_string(),
         })?;
+        // a resume continues the recorded selection unless it is given another (then the run
+        // covers both); runs recorded before selections were kept continue with the one given
+        let raw: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+        if let Some(recorded) = raw.get("tasks").and_then(|t| t.as_str()) {
+            let recorded = parse_tasks(recorded).map_err(|e| EvalError::Corrupt {
+                path: run_path.clone(),
+                line: 1,
+                problem: format!("field tasks: {e}"),
+            })?;
+            if selection.is_empty() {
+                selection = recorded.clone();
+                recorded_selection = recorded;
+            } else if recorded.is_empty() {
+                recorded_selection = recorded;
+            } else {
+                recorded_selection.extend_from_slice(&recorded);
+                recorded_selection.sort_unstable();
+                recorded_selection.dedup();
+            }
+        }
         if !setup.run.same_run(&before) {
             return Err(EvalError::Argument(format!(
                 "cannot resume: {} was made with different settings ({}), now {}",
@@ -320,9 +377,14 @@ pub fn evaluate(
     } else {
         std::fs::write(&results_path, "").map_err(io(&results_path))?;
     }
+    let tasks = select_tasks(setup.worlds, &selection)?;
+    let mut record = serde_json::to_value(&setup.run).expect("run info serialises");
+    if let Some(fields) = record.as_object_mut() {
+        fields.insert("tasks".into(), format_tasks(&recorded_selection).into());
+    }
     std::fs::write(
         &run_path,
-        serde_json::to_string_pretty(&setup.run).expect("run info serialises"),
+        serde_json::to_string_pretty(&record).expect("run info serialises"),
     )
     .map_err(io(&run_path))?;
 

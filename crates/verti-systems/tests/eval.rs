@@ -158,7 +158,8 @@ fn a_torn_results_file_resumes_without_losing_or_repeating_trials() {
     let e = evaluate(&s, &[], &make, &|_| {}).unwrap_err().to_string();
     assert!(e.contains("different settings"), "{e}");
     s.run.seed = 0;
-    let resumed = evaluate(&s, &[], &make, &|_| {}).unwrap();
+    // the killed run covered tasks 1-7; extend it to the whole set
+    let resumed = evaluate(&s, &parse_tasks("1-20").unwrap(), &make, &|_| {}).unwrap();
     assert_same(
         resumed,
         full.clone(),
@@ -298,4 +299,40 @@ fn absurd_worker_counts_are_refused() {
     assert!(e.contains("--jobs 10000 is too many"), "{e}");
     assert!(verti_bench::eval::check_jobs(verti_bench::eval::max_jobs(), "--jobs").is_ok());
     assert!(verti_bench::eval::check_jobs(0, "--jobs").is_err());
+}
+
+#[test]
+fn a_resume_continues_the_recorded_selection() {
+    let ws = worlds(2);
+    let hmmwv = vehicles::builtin("hmmwv").unwrap();
+    let make = || verti_systems::create("pid", &[]).unwrap();
+    let out = tmp("selection");
+    let recorded = || {
+        let text = std::fs::read_to_string(out.join("run.json")).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["tasks"].as_str().unwrap().to_string()
+    };
+    evaluate(
+        &setup(&ws, &hmmwv, out.clone(), 1, "pid"),
+        &parse_tasks("1-3").unwrap(),
+        &make,
+        &|_| {},
+    )
+    .unwrap();
+    assert_eq!(recorded(), "1-3");
+    let mut s = setup(&ws, &hmmwv, out.clone(), 1, "pid");
+    s.force = false;
+    s.resume = true;
+    // no --tasks: the recorded three, not the whole set
+    let all = evaluate(&s, &[], &make, &|_| {}).unwrap();
+    assert_eq!(all.len(), 3);
+    // told otherwise: those run too, and the run now covers both
+    let all = evaluate(&s, &parse_tasks("5,12").unwrap(), &make, &|_| {}).unwrap();
+    assert_eq!(
+        all.iter().map(|r| r.task).collect::<Vec<_>>(),
+        vec![1, 2, 3, 5, 12]
+    );
+    assert_eq!(recorded(), "1-3,5,12");
+    assert_eq!(verti_bench::eval::format_tasks(&[]), "all");
+    assert_eq!(parse_tasks("all").unwrap(), Vec::<u32>::new());
 }
