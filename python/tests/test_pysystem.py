@@ -124,3 +124,17 @@ def test_arguments_that_used_to_mean_something_else_are_refused(worlds, tmp_path
         verti.evaluate("pid", worlds, tasks=1, jobs=10_000)
     with pytest.raises(ValueError, match="selects nothing"):
         verti.NavigateEnv(worlds, levels=[])
+
+
+def test_reset_task_must_be_a_task_number_and_save_does_not_overwrite(worlds, tmp_path):
+    env = verti.NavigateEnv(worlds)
+    with pytest.raises(ValueError, match="task number"):
+        env.reset(options={"task": 1.5})
+    obs, info = env.reset(options={"task": 2})
+    assert info["task"] == 2
+    path = tmp_path / "w"
+    worlds[0].save(str(path))
+    with pytest.raises(FileExistsError, match="overwrite=True"):
+        worlds[0].save(str(path))
+    worlds[0].save(str(path), overwrite=True)
+    assert verti.World.load(str(path)) == worlds[0]

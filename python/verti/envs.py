@@ -246,6 +246,8 @@ class NavigateEnv(gym.Env):
         if unknown:
             raise ValueError(f"unknown reset options {sorted(unknown)}; known: 'task'")
         task = options.get("task", self._task)
+        if task is not None and (isinstance(task, bool) or not isinstance(task, (int, np.integer)) or task < 1):
+            raise ValueError(f"options['task'] must be a task number >= 1, not {task!r}")
         if seed is not None:
             core_seed = int(seed)
         elif not self._sampler_seeded:

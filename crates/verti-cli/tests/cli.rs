@@ -146,6 +146,20 @@ fn bad_input_gets_clear_errors() {
         "verti-1",
     ]);
     assert!(e.contains("hovercraft") && e.contains("hmmwv"), "{e}");
+    // a vehicle file that is not there is a missing file, not an unknown vehicle name
+    let e = run_err(&[
+        "eval",
+        "--system",
+        "pid",
+        "--vehicle",
+        "/nonexistent/rover.yaml",
+        "--worlds",
+        "verti-1",
+    ]);
+    assert!(
+        e.contains("rover.yaml") && !e.contains("unknown vehicle"),
+        "{e}"
+    );
     let e = run_err(&["eval", "--param", "speed=fast"]);
     assert!(
         e.contains("system pid parameter speed: `fast` is not a number"),

@@ -178,6 +178,14 @@ pub fn import_vb(
     options: &ImportOptions,
 ) -> Result<World> {
     crate::scale::check_scale(options.scale)?;
+    // the same range as generation: a non-finite clearance would write a world that cannot be
+    // loaded back
+    if !(options.clearance.is_finite() && (0.0..=20.0).contains(&options.clearance)) {
+        return Err(WorldError::Argument(format!(
+            "clearance {} m is out of range: it must be in [0, 20] (full-scale metres)",
+            options.clearance
+        )));
+    }
     let cfg = read_config(config)?;
     let s = options.scale;
     let level = ElevationLevel::from_name(&cfg.terrain.difficulty).ok_or_else(|| {

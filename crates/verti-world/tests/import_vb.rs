@@ -267,3 +267,22 @@ fn bad_inputs_name_the_file_and_field() {
     }
     std::fs::remove_dir_all(&tmp).ok();
 }
+
+#[test]
+fn a_clearance_that_is_not_a_length_is_refused_before_anything_is_read() {
+    for bad in [f64::NAN, f64::INFINITY, -1.0, 100.0] {
+        let opts = verti_world::import_vb::ImportOptions {
+            clearance: bad,
+            ..Default::default()
+        };
+        let e = verti_world::import_vb::import_vb(
+            std::path::Path::new("missing.yaml"),
+            std::path::Path::new("missing.bmp"),
+            None,
+            &opts,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("clearance") && e.contains("[0, 20]"), "{e}");
+    }
+}

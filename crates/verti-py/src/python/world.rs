@@ -143,8 +143,16 @@ impl PyWorld {
         Ok(PyWorld { inner: Arc::new(w) })
     }
 
-    /// Writes the world as a directory in verti's format.
-    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+    /// Writes the world as a directory in verti's format. An existing directory is replaced
+    /// only with `overwrite=True` (like the CLI's `--force`).
+    #[pyo3(signature = (path, overwrite = false))]
+    fn save(&self, py: Python<'_>, path: PathBuf, overwrite: bool) -> PyResult<()> {
+        if !overwrite && path.exists() {
+            return Err(pyo3::exceptions::PyFileExistsError::new_err(format!(
+                "{} already exists: pass overwrite=True to replace it",
+                path.display()
+            )));
+        }
         let w = self.inner.clone();
         detached(py, move || verti_world::format::save_world(&w, &path))?.map_err(world_err)
     }
