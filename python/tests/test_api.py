@@ -318,3 +318,29 @@ def test_ctrl_c_interrupts_world_generation():
         signal.signal(signal.SIGALRM, old)
     # the worlds in flight finish (about 20 ms each), the rest are skipped
     assert time.perf_counter() - t0 < 3.0
+
+
+@pytest.mark.skipif(os.name != "posix", reason="uses SIGALRM")
+def test_ctrl_c_stops_an_evaluation_with_a_results_folder_promptly(world, tmp_path):
+    """Issue 10: with out=, Ctrl-C used to wait for the whole batch (MPPI: 50 s); trials cut
+    short are not recorded."""
+    import json
+    import signal
+    import time
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    signal.setitimer(signal.ITIMER_REAL, 0.5)
+    t0 = time.perf_counter()
+    out = tmp_path / "mppi"
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            verti.evaluate("mppi", [world], jobs=1, max_time=600.0, out=str(out))
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    assert time.perf_counter() - t0 < 5.0
+    for line in (out / "results.jsonl").read_text().splitlines():
+        assert json.loads(line)["outcome"] != "error"

@@ -4,13 +4,13 @@ use super::*;
 
 /// Wraps a system so an interrupted evaluation ends its running trials at their next control
 /// step: once `cancel` is raised the system returns an invalid action, which `run_episode`
-/// ends at once (that trial is then discarded, never reported).
-pub(super) struct Cancellable<'a> {
+/// ends at once (that trial is then discarded, never reported or recorded).
+pub(super) struct Cancellable {
     inner: Box<dyn MobilitySystem>,
-    cancel: &'a AtomicBool,
+    cancel: Arc<AtomicBool>,
 }
 
-impl MobilitySystem for Cancellable<'_> {
+impl MobilitySystem for Cancellable {
     fn name(&self) -> &str {
         self.inner.name()
     }
@@ -218,7 +218,7 @@ pub(super) fn evaluate(
         episode,
     } = prepare(py, &setup)?;
     let out = setup.out;
-    let cancel = AtomicBool::new(false);
+    let cancel = Arc::new(AtomicBool::new(false));
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
         .build()
@@ -236,7 +236,7 @@ pub(super) fn evaluate(
                         let inner = registry.build(system, &params).expect("checked above");
                         let mut sys = Cancellable {
                             inner,
-                            cancel: &cancel,
+                            cancel: cancel.clone(),
                         };
                         let r = run_episode(&worlds[wi], &spec, pair, &mut sys, &episode, None);
                         (!cancel.load(Ordering::Relaxed)).then_some(r)
@@ -292,7 +292,13 @@ pub(super) fn evaluate(
             cancel: Some(&cancel),
             warn: Some(&note),
         };
-        let make = || registry.build(system, &params).expect("checked above");
+        // trials in flight stop at their next control step on Ctrl-C, and are not recorded
+        let make = || -> Box<dyn MobilitySystem> {
+            Box::new(Cancellable {
+                inner: registry.build(system, &params).expect("checked above"),
+                cancel: cancel.clone(),
+            })
+        };
         all = interruptible(py, &cancel, || {
             verti_bench::eval::evaluate(&setup, chunk, &make, &|_| {})
         })?
