@@ -153,6 +153,17 @@ pub fn select_tasks(
     worlds: &[Arc<World>],
     selection: &[u32],
 ) -> Result<Vec<(usize, u32)>, EvalError> {
+    // task numbers come from world indices: two worlds with one index would share numbers
+    // (and results), so a set must not hold the same world or index twice
+    let mut by_index: std::collections::BTreeMap<u32, &str> = Default::default();
+    for w in worlds {
+        if let Some(first) = by_index.insert(w.meta.index, &w.meta.name) {
+            return Err(EvalError::Argument(format!(
+                "worlds `{first}` and `{}` both have index {}: their task numbers would collide (is a world listed twice?)",
+                w.meta.name, w.meta.index
+            )));
+        }
+    }
     let mut all = Vec::new();
     for (wi, w) in worlds.iter().enumerate() {
         for t in &w.tasks {

@@ -217,7 +217,22 @@ impl VehicleSpec {
             path: path.to_path_buf(),
             source,
         })?;
-        Self::from_yaml_str(&text, &path.display().to_string())
+        let spec = Self::from_yaml_str(&text, &path.display().to_string())?;
+        // results record vehicles by name: a different vehicle under a built-in's name would be
+        // taken for the built-in (an exact copy of a built-in is fine)
+        if let Ok(builtin) = crate::vehicles::builtin(&spec.name)
+            && builtin != spec
+        {
+            return Err(SpecError::Invalid {
+                origin: path.display().to_string(),
+                field: "name".into(),
+                problem: format!(
+                    "`{}` is the name of a built-in vehicle, and this one differs from it: give it a name of its own",
+                    spec.name
+                ),
+            });
+        }
+        Ok(spec)
     }
 
     /// YAML text of this vehicle (round-trips through [`VehicleSpec::from_yaml_str`]).

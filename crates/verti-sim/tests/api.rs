@@ -55,6 +55,24 @@ fn bad_vehicle_files_name_the_file_and_the_field() {
     let msg = VehicleSpec::from_file(&path).unwrap_err().to_string();
     assert!(msg.contains("bad.yaml") && msg.contains("colour"), "{msg}");
 
+    // a different vehicle may not pass for a built-in one; a renamed one or an exact copy loads
+    let text = vehicles::builtin_yaml("hmmwv")
+        .unwrap()
+        .replace("stiffness: 167071.0", "stiffness: 150000.0");
+    std::fs::write(&path, &text).unwrap();
+    let msg = VehicleSpec::from_file(&path).unwrap_err().to_string();
+    assert!(
+        msg.contains("bad.yaml") && msg.contains("`hmmwv` is the name of a built-in vehicle"),
+        "{msg}"
+    );
+    std::fs::write(&path, text.replace("name: hmmwv", "name: soft-hmmwv")).unwrap();
+    assert_eq!(VehicleSpec::from_file(&path).unwrap().name, "soft-hmmwv");
+    std::fs::write(&path, vehicles::builtin_yaml("hmmwv").unwrap()).unwrap();
+    assert_eq!(
+        VehicleSpec::from_file(&path).unwrap(),
+        vehicles::builtin("hmmwv").unwrap()
+    );
+
     let msg = VehicleSpec::from_file(dir.join("missing.yaml"))
         .unwrap_err()
         .to_string();

@@ -177,6 +177,16 @@ fn a_torn_results_file_resumes_without_losing_or_repeating_trials() {
 }
 
 #[test]
+fn a_set_holding_one_world_twice_is_refused() {
+    let ws = worlds(2);
+    let twice = vec![ws[0].clone(), ws[1].clone(), ws[0].clone()];
+    let e = verti_bench::eval::select_tasks(&twice, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("both have index 1"), "{e}");
+}
+
+#[test]
 fn bad_task_selections_are_rejected() {
     for bad in ["0", "5-1", "abc", "1,,2", "3-x", ""] {
         let e = parse_tasks(bad).unwrap_err().to_string();
