@@ -208,7 +208,14 @@ pub fn select_tasks(
 
 /// Reads a results file; a torn last line (from a kill) is dropped and reported as `false`.
 pub fn read_results(path: &Path) -> Result<(Vec<TrialResult>, bool), EvalError> {
+    read_results_file(path).map(|(results, clean, _)| (results, clean))
+}
+
+/// [`read_results`], plus whether the file ends in a newline (a last line that lost only its
+/// newline parses, but the next append would be glued onto it).
+fn read_results_file(path: &Path) -> Result<(Vec<TrialResult>, bool, bool), EvalError> {
     let text = std::fs::read_to_string(path).map_err(io(path))?;
+    let ends_in_newline = text.is_empty() || text.ends_with('\n');
     let mut out = Vec::new();
     let lines: Vec<&str> = text.split('\n').collect();
     let mut clean = true;
@@ -229,7 +236,7 @@ pub fn read_results(path: &Path) -> Result<(Vec<TrialResult>, bool), EvalError> 
             }
         }
     }
-    Ok((out, clean))
+    Ok((out, clean, ends_in_newline))
 }
 
 /// Where per-step logs of trials go: `write` receives each finished trial with its log (the
@@ -363,11 +370,7 @@ pub fn evaluate(
                 serde_json::to_string(&setup.run).expect("run info serialises"),
             )));
         }
-        let (rs, clean) = read_results(&results_path)?;
-        let ends_in_newline = std::fs::read(&results_path)
-            .map_err(io(&results_path))?
-            .last()
-            .is_none_or(|b| *b == b'\n');
+        let (rs, clean, ends_in_newline) = read_results_file(&results_path)?;
         if !clean && let Some(warn) = setup.warn {
             warn(&format!(
                 "{}: dropped a torn last line (a run killed while writing); that task runs again",

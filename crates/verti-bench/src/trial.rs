@@ -339,6 +339,14 @@ impl Trial {
         r
     }
 
+    /// The record being accumulated, without a copy: its running statistics (roll, pitch,
+    /// throttle, steering, path length) are current; the end fields (outcome, time, final
+    /// distance and roll) are set only once the trial has ended. See [`Trial::result_so_far`]
+    /// for a complete record at any time.
+    pub fn running_result(&self) -> &TrialResult {
+        &self.result
+    }
+
     /// The result as it stands (outcome `error` while running; `wall_time` 0).
     pub fn result_so_far(&self) -> TrialResult {
         let mut r = self.result.clone();

@@ -496,18 +496,14 @@ impl PyVecEnvCore {
     /// where an entry applies to some environments only).
     fn batch_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        let metrics: Vec<TrialResult> = self
-            .v
-            .envs
-            .iter()
-            .map(|e| e.episode().expect("reset before use").metrics())
-            .collect();
         let eps: Vec<&Episode> = self
             .v
             .envs
             .iter()
             .map(|e| e.episode().expect("reset before use"))
             .collect();
+        // running statistics only: no copy of each record per batch
+        let metrics: Vec<&TrialResult> = eps.iter().map(|e| e.trial().running_result()).collect();
         let codes: Vec<i8> = self
             .v
             .reports
