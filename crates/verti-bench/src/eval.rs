@@ -8,6 +8,7 @@
 //! number of jobs (only `wall_time` differs).
 
 use crate::episode::{EpisodeConfig, TrialResult, run_episode};
+use crate::identity::RunRecord;
 use crate::system::MobilitySystem;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -21,6 +22,8 @@ use verti_world::{TaskId, World};
 
 pub const RESULTS_FILE: &str = "results.jsonl";
 pub const RUN_FILE: &str = "run.json";
+/// Subdirectory of a run's per-step logs (one Parquet file per trial).
+pub const STEPS_DIR: &str = "steps";
 
 #[derive(Debug, thiserror::Error)]
 pub enum EvalError {
@@ -117,13 +120,14 @@ pub fn parse_tasks(spec: &str) -> Result<Vec<u32>, EvalError> {
     Ok(out.into_iter().collect())
 }
 
-/// What a run is; stored in `run.json` and compared on resume.
+/// What a run is, as its caller describes it; `run.json` holds it with the content digests
+/// of the worlds and vehicle ([`crate::identity::RunRecord`]) and is compared on resume.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunInfo {
     pub system: String,
     /// Every parameter of the system (defaults included), resolved by its registry. Older
     /// `run.json` files hold only the parameters given, as `[name, number]` pairs; they still
-    /// resume (see [`RunInfo::same_run`]).
+    /// resume (see [`RunRecord::differences`]).
     pub params: verti_core::params::Params,
     pub vehicle: String,
     pub worlds: String,
@@ -132,19 +136,6 @@ pub struct RunInfo {
     pub rules: crate::episode::Rules,
     pub seed: u64,
     pub max_time: f64,
-}
-
-impl RunInfo {
-    /// Whether `recorded` (read from `run.json`) describes this run: every field equal, and
-    /// the recorded parameters, taken at their declared types with missing ones at their
-    /// defaults, equal to these.
-    pub fn same_run(&self, recorded: &RunInfo) -> bool {
-        let bare = |r: &RunInfo| RunInfo {
-            params: Default::default(),
-            ..r.clone()
-        };
-        bare(self) == bare(recorded) && self.params.same_as_recorded(&recorded.params)
-    }
 }
 
 /// Resolves the selected task numbers against a set: all tasks of the set when `selection` is
@@ -327,6 +318,13 @@ pub fn evaluate(
     }
     let results_path = setup.out.join(RESULTS_FILE);
     let run_path = setup.out.join(RUN_FILE);
+    let steps_path = setup.out.join(STEPS_DIR);
+    let mut record = RunRecord::new(
+        &setup.run,
+        setup.worlds,
+        setup.vehicle,
+        setup.step_log.as_ref().map(|s| s.seconds),
+    );
 
     let mut previous = Vec::new();
     if results_path.exists() && !setup.force {
@@ -336,16 +334,14 @@ pub fn evaluate(
                 results_path.display()
             )));
         }
-        let text = std::fs::read_to_string(&run_path).map_err(io(&run_path))?;
-        let before: RunInfo = serde_json::from_str(&text).map_err(|e| EvalError::Corrupt {
-            path: run_path.clone(),
-            line: 1,
-            problem: e.to_string(),
-        })?;
+        let mut before = RunRecord::read(&run_path)?;
+        if before.by_name_only() {
+            // a record from before content digests cannot say whether step logs were kept
+            before.step_log = record.step_log.clone();
+        }
         // a resume continues the recorded selection unless it is given another (then the run
         // covers both); runs recorded before selections were kept continue with the one given
-        let raw: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
-        if let Some(recorded) = raw.get("tasks").and_then(|t| t.as_str()) {
+        if let Some(recorded) = &before.tasks {
             let recorded = parse_tasks(recorded).map_err(|e| EvalError::Corrupt {
                 path: run_path.clone(),
                 line: 1,
@@ -362,13 +358,22 @@ pub fn evaluate(
                 recorded_selection.dedup();
             }
         }
-        if !setup.run.same_run(&before) {
+        let differences = record.differences(&before);
+        if !differences.is_empty() {
             return Err(EvalError::Argument(format!(
-                "cannot resume: {} was made with different settings ({}), now {}",
+                "cannot resume {}: {} records a different run ({}); start a new run with another --out, or pass --force to discard it",
+                setup.out.display(),
                 run_path.display(),
-                serde_json::to_string(&before).expect("run info serialises"),
-                serde_json::to_string(&setup.run).expect("run info serialises"),
+                differences.join("; ")
             )));
+        }
+        if before.by_name_only()
+            && let Some(warn) = setup.warn
+        {
+            warn(&format!(
+                "{} predates content digests: its world set and vehicle were checked by name only",
+                run_path.display()
+            ));
         }
         let (rs, clean, ends_in_newline) = read_results_file(&results_path)?;
         if !clean && let Some(warn) = setup.warn {
@@ -390,12 +395,16 @@ pub fn evaluate(
         previous = rs;
     } else {
         std::fs::write(&results_path, "").map_err(io(&results_path))?;
+        // a fresh start keeps no step logs of an earlier run in this directory
+        if steps_path.exists() {
+            std::fs::remove_dir_all(&steps_path).map_err(io(&steps_path))?;
+        }
+    }
+    if setup.step_log.is_some() {
+        std::fs::create_dir_all(&steps_path).map_err(io(&steps_path))?;
     }
     let tasks = select_tasks(setup.worlds, &selection)?;
-    let mut record = serde_json::to_value(&setup.run).expect("run info serialises");
-    if let Some(fields) = record.as_object_mut() {
-        fields.insert("tasks".into(), format_tasks(&recorded_selection).into());
-    }
+    record.tasks = Some(format_tasks(&recorded_selection));
     std::fs::write(
         &run_path,
         serde_json::to_string_pretty(&record).expect("run info serialises"),

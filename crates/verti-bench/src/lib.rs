@@ -19,6 +19,7 @@
 pub mod episode;
 pub mod eval;
 pub mod features;
+pub mod identity;
 pub mod metrics;
 pub mod observation;
 pub mod path;

@@ -2,12 +2,13 @@
 
 use crate::progress::bar;
 use crate::vehicle_cmd::load_vehicle;
-use crate::world_cmd::{CmdResult, ScaleArg, ensure_parent, load_set_with_progress};
+use crate::world_cmd::{CmdResult, ScaleArg, ensure_parent, load_set_checked};
 use clap::Args;
 use std::path::PathBuf;
 use std::sync::Arc;
 use verti_bench::episode::{EpisodeLog, Outcome, Rules};
 use verti_bench::eval::{EvalSetup, RUN_FILE, RunInfo, evaluate, parse_tasks, read_results};
+use verti_bench::identity::RunRecord;
 use verti_bench::{EpisodeConfig, run_episode};
 use verti_world::World;
 
@@ -102,12 +103,15 @@ pub fn eval(a: EvalArgs) -> CmdResult {
     // build one up front so that a system that cannot be built fails before any work
     registry.build(&a.system, &params)?;
     let selection = parse_tasks(&a.tasks)?;
+    let (set, scale) = load_set_checked(&a.worlds, &a.scale)?;
     let vehicle_name = a
         .vehicle
         .clone()
-        .unwrap_or_else(|| default_vehicle(a.scale.scale).to_string());
+        .unwrap_or_else(|| default_vehicle(scale).to_string());
     let vehicle = load_vehicle(&vehicle_name)?;
-    let set = load_set_with_progress(&a.worlds, a.scale.scale)?;
+    if let Some(w) = verti_bench::identity::scale_mismatch(&vehicle, scale) {
+        eprintln!("warning: {w}");
+    }
     let worlds: Vec<Arc<World>> = set.worlds.into_iter().map(Arc::new).collect();
     let out = a
         .out
@@ -133,7 +137,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
             params: params.clone(),
             vehicle: vehicle.name.clone(),
             worlds: a.worlds.clone(),
-            scale: a.scale.scale,
+            scale,
             rules: a.rules,
             seed: a.seed,
             max_time: a.max_time,
@@ -142,7 +146,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         cancel: None,
         warn: Some(&warn),
     };
-    let steps_dir = out.join("steps");
+    let steps_dir = out.join(verti_bench::eval::STEPS_DIR);
     let write_log = |r: &verti_bench::TrialResult, log: &EpisodeLog| {
         let path = steps_dir.join(verti_log::log_file_name(r.task));
         verti_log::write_steps(&path, r, &log.steps).map_err(|e| e.to_string())
@@ -151,8 +155,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         step_log: match a.log_steps.as_deref() {
             None => None,
             Some(kind) => {
-                std::fs::create_dir_all(&steps_dir)
-                    .map_err(|e| format!("{}: {e}", steps_dir.display()))?;
+                // `evaluate` creates the directory (and empties it on a fresh start)
                 Some(verti_bench::eval::StepLogSink {
                     seconds: if kind == "all" { f64::INFINITY } else { 10.0 },
                     write: &write_log,
@@ -229,10 +232,8 @@ pub struct ReplayArgs {
 /// its trajectory over the world, coloured by speed, with the failure point marked.
 pub fn replay(a: ReplayArgs) -> CmdResult {
     let run_path = a.result.join(RUN_FILE);
-    let run: RunInfo = serde_json::from_str(
-        &std::fs::read_to_string(&run_path).map_err(|e| format!("{}: {e}", run_path.display()))?,
-    )
-    .map_err(|e| format!("{}: {e}", run_path.display()))?;
+    let record = RunRecord::read(&run_path)?;
+    let run = &record.run;
     let (results, _) = read_results(&a.result.join(verti_bench::eval::RESULTS_FILE))?;
     let recorded = results.iter().find(|r| r.task == a.task).ok_or_else(|| {
         format!(
@@ -242,12 +243,43 @@ pub fn replay(a: ReplayArgs) -> CmdResult {
             results.len()
         )
     })?;
-    let vehicle = load_vehicle(&run.vehicle)?;
+    let vehicle = match &record.vehicle_spec {
+        Some(spec) => spec.clone(),
+        None => load_vehicle(&run.vehicle)?,
+    };
+    if let Some(d) = &record.vehicle_digest
+        && *d != verti_bench::identity::vehicle_digest(&vehicle)
+    {
+        return Err(format!(
+            "{}: vehicle `{}` is not the one the run drove (its contents changed since)",
+            run_path.display(),
+            run.vehicle
+        )
+        .into());
+    }
     let id = verti_world::TaskId::from_number(a.task).ok_or("task numbers start at 1")?;
-    let world = Arc::new(verti_world::sets::resolve_world(
-        &format!("{}:{}", run.worlds, id.world),
-        run.scale,
-    )?);
+    // the whole set, to check by content that it is still the set the run used
+    let set: Vec<Arc<World>> = verti_world::sets::resolve_set(&run.worlds, run.scale, &|| {})
+        .map_err(|e| format!("the run's world set `{}`: {e}", run.worlds))?
+        .worlds
+        .into_iter()
+        .map(Arc::new)
+        .collect();
+    if let Some(d) = &record.worlds_digest
+        && *d != verti_bench::identity::set_digest(&set)
+    {
+        return Err(format!(
+            "`{}` no longer holds the worlds the run in {} used (their contents differ); run `verti replay` where the run was made, or restore the set",
+            run.worlds,
+            a.result.display()
+        )
+        .into());
+    }
+    let world = set
+        .iter()
+        .find(|w| w.meta.index == id.world)
+        .cloned()
+        .ok_or_else(|| format!("`{}` has no world {}", run.worlds, id.world))?;
     let mut system = crate::registries::systems().build(&run.system, &run.params)?;
     let cfg = EpisodeConfig {
         rules: run.rules,

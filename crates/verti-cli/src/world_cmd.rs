@@ -68,8 +68,17 @@ pub struct StatsArgs {
 #[derive(Args)]
 pub struct ScaleArg {
     /// World scale: 1, 1/6, 1/10 or any decimal in (0, 10]. Every length is multiplied by it.
-    #[arg(long, default_value = "1", value_parser = scale_parser)]
-    pub scale: f64,
+    /// Default 1 for generated and imported worlds; saved worlds keep the scale they were saved
+    /// at, and asking for another is an error.
+    #[arg(long, value_parser = scale_parser)]
+    pub scale: Option<f64>,
+}
+
+impl ScaleArg {
+    /// The scale to generate or import at.
+    pub fn value(&self) -> f64 {
+        self.scale.unwrap_or(1.0)
+    }
 }
 
 fn scale_parser(s: &str) -> Result<f64, String> {
@@ -175,7 +184,7 @@ fn generate(a: GenerateArgs) -> CmdResult {
     let config = SetConfig {
         seed: a.seed,
         count: a.count,
-        scale: a.scale.scale,
+        scale: a.scale.value(),
         clearance: a.clearance,
     };
     config.validate()?;
@@ -239,7 +248,7 @@ fn count_by<K: Ord + std::fmt::Display>(worlds: &[World], key: impl Fn(&World) -
 
 fn import(a: ImportArgs) -> CmdResult {
     let opts = ImportOptions {
-        scale: a.scale.scale,
+        scale: a.scale.value(),
         clearance: a.clearance,
         index: None,
     };
@@ -285,13 +294,13 @@ fn import(a: ImportArgs) -> CmdResult {
 }
 
 fn show(a: ShowArgs) -> CmdResult {
-    let w = resolve_world(&a.world, a.scale.scale)?;
+    let w = resolve_world_checked(&a.world, &a.scale)?;
     print!("{}", describe(&w));
     Ok(())
 }
 
 fn render(a: RenderArgs) -> CmdResult {
-    let w = resolve_world(&a.world, a.scale.scale)?;
+    let w = resolve_world_checked(&a.world, &a.scale)?;
     let options = verti_render::RenderOptions {
         pixels_per_cell: a.px_per_cell,
         pairs: a.pairs,
@@ -305,7 +314,7 @@ fn render(a: RenderArgs) -> CmdResult {
 }
 
 fn stats(a: StatsArgs) -> CmdResult {
-    let set = load_set_with_progress(&a.set, a.scale.scale)?;
+    let (set, _) = load_set_checked(&a.set, &a.scale)?;
     let stats = verti_world::stats::set_stats(&set.worlds);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&stats)?);
@@ -382,6 +391,24 @@ pub fn describe(w: &World) -> String {
 }
 
 /// Resolves a set for commands that take one, with a progress bar.
+/// A world set at the requested scale, and its scale: an explicit `--scale` that a saved set
+/// cannot honour is an error rather than ignored.
+pub fn load_set_checked(
+    spec: &str,
+    scale: &ScaleArg,
+) -> Result<(verti_world::sets::WorldSet, f64), WorldError> {
+    let set = load_set_with_progress(spec, scale.value())?;
+    let actual = verti_world::scale::set_scale(spec, &set.worlds, scale.scale)?;
+    Ok((set, actual))
+}
+
+/// One world at the requested scale (see [`load_set_checked`]).
+fn resolve_world_checked(spec: &str, scale: &ScaleArg) -> Result<verti_world::World, WorldError> {
+    let w = resolve_world(spec, scale.value())?;
+    verti_world::scale::set_scale(spec, [&w], scale.scale)?;
+    Ok(w)
+}
+
 pub fn load_set_with_progress(
     spec: &str,
     scale: f64,

@@ -4,9 +4,11 @@
 //!   (world generation, noise in planners, random exploration) draws from it, so a seed means
 //!   the same bits on every machine and with every thread count.
 //! * [`math`]: `Vec3`, `Quat` and `Mat3` in `f64`, just what a vehicle engine needs.
+//! * [`digest`]: content digests, so a run records what it ran by content.
 //! * [`params`] and [`registry`]: typed, documented parameters and open registries of things
 //!   built by name from them (mobility systems, elevation sources).
 
+pub mod digest;
 pub mod math;
 pub mod params;
 pub mod registry;

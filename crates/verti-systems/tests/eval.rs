@@ -156,7 +156,7 @@ fn a_torn_results_file_resumes_without_losing_or_repeating_trials() {
     s.resume = true;
     s.run.seed = 1;
     let e = evaluate(&s, &[], &make, &|_| {}).unwrap_err().to_string();
-    assert!(e.contains("different settings"), "{e}");
+    assert!(e.contains("seed: 0 recorded, 1 now"), "{e}");
     s.run.seed = 0;
     // the killed run covered tasks 1-7; extend it to the whole set
     let resumed = evaluate(&s, &parse_tasks("1-20").unwrap(), &make, &|_| {}).unwrap();

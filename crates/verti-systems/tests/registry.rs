@@ -216,10 +216,10 @@ fn run_json_records_every_parameter_and_resumes_old_and_new_records() {
         serde_json::json!({"label": "scripted", "weights": weights.to_str().unwrap(), "mode": "file"})
     );
     // the recorded values rebuild the system (as `verti replay` does)
-    let recorded: RunInfo =
+    let recorded: verti_bench::identity::RunRecord =
         serde_json::from_str(&std::fs::read_to_string(out.join(RUN_FILE)).unwrap()).unwrap();
     assert_eq!(
-        r.build("scripted", &recorded.params).unwrap().name(),
+        r.build("scripted", &recorded.run.params).unwrap().name(),
         "scripted"
     );
 
@@ -244,7 +244,8 @@ fn run_json_records_every_parameter_and_resumes_old_and_new_records() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("different settings") && e.contains("renamed"),
+        e.contains("a different run")
+            && e.contains("parameter `label`: scripted recorded, renamed now"),
         "{e}"
     );
 
@@ -282,5 +283,5 @@ fn run_json_records_every_parameter_and_resumes_old_and_new_records() {
     let e = evaluate(&resume, &[], &make_pid, &|_| {})
         .unwrap_err()
         .to_string();
-    assert!(e.contains("different settings"), "{e}");
+    assert!(e.contains("parameter `speed`: 4 recorded"), "{e}");
 }

@@ -57,6 +57,49 @@ pub fn scale_label(value: f64) -> String {
     format!("{value}")
 }
 
+/// The one scale of a loaded set, checked against a scale the user asked for. Generated and
+/// imported sets are built at the requested scale; saved sets (and worlds) carry their own, so
+/// asking for another one is an error rather than being ignored, and a set whose worlds differ
+/// in scale is refused (lengths, speeds and rules all depend on it).
+pub fn set_scale<'a>(
+    spec: &str,
+    worlds: impl IntoIterator<Item = &'a crate::World>,
+    requested: Option<f64>,
+) -> Result<f64> {
+    let mut found: Option<(f64, &str)> = None;
+    for w in worlds {
+        match found {
+            None => found = Some((w.meta.scale, &w.meta.name)),
+            Some((s, first)) if !same_scale(s, w.meta.scale) => {
+                return Err(WorldError::Argument(format!(
+                    "`{spec}` mixes world scales: {first} is at scale {} and {} at scale {}",
+                    scale_label(s),
+                    w.meta.name,
+                    scale_label(w.meta.scale)
+                )));
+            }
+            Some(_) => {}
+        }
+    }
+    let Some((scale, _)) = found else {
+        return Err(WorldError::Argument(format!("`{spec}` holds no worlds")));
+    };
+    if let Some(r) = requested
+        && !same_scale(r, scale)
+    {
+        return Err(WorldError::Argument(format!(
+            "--scale {} does not apply to `{spec}`: its worlds were saved at scale {} and keep it (drop --scale, or generate or import the set again at the scale you want)",
+            scale_label(r),
+            scale_label(scale)
+        )));
+    }
+    Ok(scale)
+}
+
+fn same_scale(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-9 * a.abs().max(b.abs())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,7 +2,8 @@
 //! ([`load_results`], [`load_results_from`]).
 
 use crate::episode::TrialResult;
-use crate::eval::{EvalError, RESULTS_FILE, read_results};
+use crate::eval::{EvalError, RESULTS_FILE, RUN_FILE, read_results};
+use crate::identity::RunRecord;
 use std::path::{Path, PathBuf};
 
 /// Why results could not be loaded.
@@ -23,6 +24,9 @@ pub enum ReportError {
     /// Reading or parsing a results file failed (the message names the file and line).
     #[error(transparent)]
     Eval(#[from] EvalError),
+    /// The same trials were given twice (one file twice, or two copies of one run).
+    #[error("{0}")]
+    Duplicate(String),
 }
 
 /// One results file that was read.
@@ -32,6 +36,8 @@ pub struct LoadedFile {
     pub trials: usize,
     /// `false` when a torn last line (a trial in flight when the run was killed) was dropped.
     pub clean: bool,
+    /// The run's `run.json` (beside a `results.jsonl`), when there is one.
+    pub run: Option<RunRecord>,
 }
 
 /// Results and the files they came from.
@@ -76,19 +82,33 @@ fn result_files(path: &Path) -> Result<Vec<PathBuf>, ReportError> {
 /// Reads results from files (`.jsonl`) and result directories, in the order given, and says
 /// which files were read. A torn last line is dropped (and reported in [`LoadedFile::clean`]);
 /// any other unparsable line is an error naming the file and line.
+///
+/// Runs are told apart by their `run.json` (see `runs`): files of one run merge, runs of one
+/// system with different settings get labels naming what differs (`pid [speed=6]`, in each
+/// result's `system`), and trials given twice are refused.
 pub fn load_results_from(paths: &[PathBuf]) -> Result<Loaded, ReportError> {
     let mut out = Loaded::default();
+    let mut per_file = Vec::new();
     for p in paths {
         for f in result_files(p)? {
             let (results, clean) = read_results(&f)?;
+            let run_path = f.with_file_name(RUN_FILE);
+            let run = if f.file_name().is_some_and(|n| n == RESULTS_FILE) && run_path.is_file() {
+                Some(RunRecord::read(&run_path)?)
+            } else {
+                None
+            };
             out.files.push(LoadedFile {
                 path: f,
                 trials: results.len(),
                 clean,
+                run,
             });
-            out.results.extend(results);
+            per_file.push(results);
         }
     }
+    super::runs::separate_runs(&out.files, &mut per_file)?;
+    out.results = per_file.into_iter().flatten().collect();
     Ok(out)
 }
 
@@ -118,8 +138,15 @@ mod tests {
         assert_eq!(loaded.results.len(), 2);
         assert!(!loaded.files[0].clean);
         // a folder of runs, and a file given directly
-        let all = load_results(&[dir.join("runs"), file.clone()]).unwrap();
+        let other = dir.join("other.jsonl");
+        std::fs::write(&other, format!("{}\n{}\n", lines[2], lines[3])).unwrap();
+        let all = load_results(&[dir.join("runs"), other.clone()]).unwrap();
         assert_eq!(all.len(), 4);
+        // ... but not one file twice: its trials would count twice
+        let e = load_results(&[dir.join("runs"), file.clone()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("given twice"), "{e}");
         // errors name the path
         let e = load_results(&[dir.join("nope")]).unwrap_err().to_string();
         assert!(e.contains("nope"), "{e}");

@@ -49,6 +49,7 @@ mod charts;
 #[cfg(test)]
 mod fixtures;
 mod load;
+mod runs;
 mod tables;
 mod writers;
 

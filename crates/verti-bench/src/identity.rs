@@ -1,0 +1,246 @@
+//! What a run is, by content: the record `verti eval` keeps in `OUT/run.json`, compared on
+//! resume, by `verti report` (to keep runs of different settings apart) and by `verti replay`
+//! (to re-run a trial on the worlds the run used).
+//!
+//! Names alone are not enough: `--worlds w` may name another set when resumed from another
+//! directory, and a vehicle file may be edited between two calls. So the record holds a digest
+//! of the world set's contents and of the vehicle spec next to the names, and a resume that
+//! differs is refused with the settings that differ, one by one.
+
+use crate::eval::{EvalError, RunInfo};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+use std::sync::Arc;
+use verti_core::digest::Digest;
+use verti_sim::VehicleSpec;
+use verti_world::World;
+
+/// Digest of everything a trial reads from one world: its description, elevation, surface
+/// patches, obstacles, tasks and global paths.
+pub fn world_digest(world: &World) -> String {
+    let mut d = Digest::new();
+    let t = &world.terrain;
+    d.debug(&world.meta)
+        .u64(t.size() as u64)
+        .f64(t.cell())
+        .f64s(t.heights())
+        .debug(&world.patches)
+        .debug(&world.obstacles)
+        .debug(&world.tasks)
+        .debug(&world.paths)
+        .f64(world.path_clearance);
+    d.hex()
+}
+
+/// Digest of a world set: its worlds' digests in index order (the order worlds were listed in
+/// does not change what a run covers).
+pub fn set_digest(worlds: &[Arc<World>]) -> String {
+    use rayon::prelude::*;
+    let mut each: Vec<(u32, String)> = worlds
+        .par_iter()
+        .map(|w| (w.meta.index, world_digest(w)))
+        .collect();
+    each.sort();
+    let mut d = Digest::new();
+    d.u64(each.len() as u64);
+    for (index, digest) in &each {
+        d.u64(*index as u64).str(digest);
+    }
+    d.hex()
+}
+
+/// Digest of a vehicle spec (every field of it, the name included).
+pub fn vehicle_digest(vehicle: &VehicleSpec) -> String {
+    let text = serde_json::to_string(vehicle).expect("vehicle specs serialise");
+    Digest::new().str(&text).hex()
+}
+
+/// How a step-log setting is recorded: `None` for no logs, `all`, or `last10` for the last
+/// 10 s of each trial.
+pub fn step_log_label(seconds: Option<f64>) -> Option<String> {
+    seconds.map(|s| {
+        if s.is_finite() {
+            format!("last{s}")
+        } else {
+            "all".to_string()
+        }
+    })
+}
+
+/// `OUT/run.json`: the run's settings as given, what they resolved to by content, and the
+/// tasks the run covers.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
+    #[serde(flatten)]
+    pub run: RunInfo,
+    /// [`set_digest`] of the worlds run (absent in runs recorded before digests).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub worlds_digest: Option<String>,
+    /// [`vehicle_digest`] of the vehicle driven (absent in runs recorded before digests).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vehicle_digest: Option<String>,
+    /// The vehicle itself, so that `verti replay` drives the same vehicle even when its file
+    /// has moved or changed (absent in runs recorded before digests).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vehicle_spec: Option<VehicleSpec>,
+    /// Per-step logs kept ([`step_log_label`]); `None` when the run keeps none.
+    #[serde(default)]
+    pub step_log: Option<String>,
+    /// The tasks the run covers (`all`, or ranges like `1-60`): not part of the identity, a
+    /// resume may extend them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tasks: Option<String>,
+}
+
+impl RunRecord {
+    /// The record of `run` over `worlds` with `vehicle` (digests computed here).
+    pub fn new(
+        run: &RunInfo,
+        worlds: &[Arc<World>],
+        vehicle: &VehicleSpec,
+        step_log: Option<f64>,
+    ) -> Self {
+        RunRecord {
+            run: run.clone(),
+            worlds_digest: Some(set_digest(worlds)),
+            vehicle_digest: Some(vehicle_digest(vehicle)),
+            vehicle_spec: Some(vehicle.clone()),
+            step_log: step_log_label(step_log),
+            tasks: None,
+        }
+    }
+
+    /// Reads `run.json`; errors name the file and what is wrong with it.
+    pub fn read(path: &Path) -> Result<Self, EvalError> {
+        let text = std::fs::read_to_string(path).map_err(|source| EvalError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        serde_json::from_str(&text).map_err(|e| EvalError::Corrupt {
+            path: path.to_path_buf(),
+            line: e.line(),
+            problem: e.to_string(),
+        })
+    }
+
+    /// Whether this record predates content digests (then worlds and vehicle can only be
+    /// compared by name).
+    pub fn by_name_only(&self) -> bool {
+        self.worlds_digest.is_none() || self.vehicle_digest.is_none()
+    }
+
+    /// The settings in which `recorded` (read from `run.json`) differs from this run, each as
+    /// `setting: recorded value, now value`; empty when it is the same run. Worlds and vehicle
+    /// compare by content when both records have digests, else by name; parameters compare
+    /// by value after resolution (missing ones at their defaults); `tasks` is not compared.
+    pub fn differences(&self, recorded: &RunRecord) -> Vec<String> {
+        let mut out = Vec::new();
+        let mut differ = |what: &str, was: String, now: String| {
+            if was != now {
+                out.push(format!("{what}: {was} recorded, {now} now"));
+            }
+        };
+        let (a, b) = (&recorded.run, &self.run);
+        differ("system", a.system.clone(), b.system.clone());
+        match (&recorded.worlds_digest, &self.worlds_digest) {
+            (Some(x), Some(y)) if x != y => out.push(format!(
+                "world set: its contents differ (`{}` recorded, `{}` now; world-set digest {} recorded, {} now)",
+                a.worlds,
+                b.worlds,
+                short(x),
+                short(y)
+            )),
+            (Some(_), Some(_)) => {}
+            _ => differ("world set", a.worlds.clone(), b.worlds.clone()),
+        }
+        let mut differ = |what: &str, was: String, now: String| {
+            if was != now {
+                out.push(format!("{what}: {was} recorded, {now} now"));
+            }
+        };
+        match (&recorded.vehicle_digest, &self.vehicle_digest) {
+            (Some(x), Some(y)) if x != y => differ(
+                "vehicle",
+                format!("`{}` (digest {})", a.vehicle, short(x)),
+                format!("`{}` (digest {})", b.vehicle, short(y)),
+            ),
+            (Some(_), Some(_)) => {}
+            _ => differ("vehicle", a.vehicle.clone(), b.vehicle.clone()),
+        }
+        differ("scale", a.scale.to_string(), b.scale.to_string());
+        differ("rules", json(&a.rules), json(&b.rules));
+        differ("seed", a.seed.to_string(), b.seed.to_string());
+        differ("max_time", a.max_time.to_string(), b.max_time.to_string());
+        differ(
+            "step logs",
+            recorded.step_log.clone().unwrap_or("none".into()),
+            self.step_log.clone().unwrap_or("none".into()),
+        );
+        if a.system == b.system {
+            out.extend(param_differences(&b.params, &a.params));
+        }
+        out
+    }
+}
+
+/// Parameters of `now` whose value differs from `recorded` (taken at `now`'s declared types,
+/// missing ones at their defaults).
+fn param_differences(
+    now: &verti_core::params::Params,
+    recorded: &verti_core::params::Params,
+) -> Vec<String> {
+    if now.same_as_recorded(recorded) {
+        return Vec::new();
+    }
+    let pairs = recorded.to_pairs();
+    let resolved = verti_core::params::Params::resolve("run.json", now.specs().clone(), &pairs);
+    let Ok(resolved) = resolved else {
+        return vec![format!(
+            "parameters: {} recorded, {} now",
+            json(recorded),
+            json(now)
+        )];
+    };
+    let mut out = Vec::new();
+    for (name, value) in now.iter() {
+        let was = resolved.get(name);
+        if was != Some(value) {
+            out.push(format!(
+                "parameter `{name}`: {} recorded, {value} now",
+                was.map_or("none".to_string(), |v| v.to_string())
+            ));
+        }
+    }
+    if out.is_empty() {
+        // same values, different sets of names (an unknown recorded name)
+        out.push(format!(
+            "parameters: {} recorded, {} now",
+            json(recorded),
+            json(now)
+        ));
+    }
+    out
+}
+
+fn json<T: Serialize>(x: &T) -> String {
+    serde_json::to_string(x).expect("settings serialise")
+}
+
+fn short(digest: &str) -> &str {
+    &digest[..digest.len().min(12)]
+}
+
+/// A warning when a vehicle built for one scale drives worlds of another (a 1/10-scale car on
+/// full-scale rocks is legal, and sometimes the point, but rarely what was meant).
+pub fn scale_mismatch(vehicle: &VehicleSpec, world_scale: f64) -> Option<String> {
+    let label = verti_world::scale::scale_label;
+    ((vehicle.scale - world_scale).abs() > 1e-9 * world_scale.abs().max(vehicle.scale.abs()))
+        .then(|| {
+            format!(
+                "vehicle {} is built for scale {} but the worlds are at scale {}: obstacles, slopes and speeds will be out of proportion",
+                vehicle.name,
+                label(vehicle.scale),
+                label(world_scale)
+            )
+        })
+}
