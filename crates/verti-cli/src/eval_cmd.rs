@@ -152,16 +152,14 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         verti_log::write_steps(&path, r, &log.steps).map_err(|e| e.to_string())
     };
     let setup = EvalSetup {
-        step_log: match a.log_steps.as_deref() {
-            None => None,
-            Some(kind) => {
-                // `evaluate` creates the directory (and empties it on a fresh start)
-                Some(verti_bench::eval::StepLogSink {
-                    seconds: if kind == "all" { f64::INFINITY } else { 10.0 },
-                    write: &write_log,
-                })
-            }
-        },
+        // `evaluate` creates the directory (and empties it on a fresh start)
+        step_log: a
+            .log_steps
+            .as_deref()
+            .map(|kind| verti_bench::eval::StepLogSink {
+                seconds: if kind == "all" { f64::INFINITY } else { 10.0 },
+                write: &write_log,
+            }),
         ..setup
     };
     let total = verti_bench::eval::select_tasks(&worlds, &selection)?.len();
