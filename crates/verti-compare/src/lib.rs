@@ -8,6 +8,8 @@
 //! * [`run`]: the verti side, set up as the reference describes ([`CompareSetup`]: world with
 //!   one rigid surface everywhere, PID with the reference's steering law), run in parallel and
 //!   deterministically.
+//! * [`driver`]: the reference runs' own driver law, to measure what the PID's differences
+//!   from it change.
 //! * [`divergence`]: lateral offset from the reference's trajectory and roll error.
 //! * [`summary`]: per-task comparison and aggregates; [`markdown`]: the report's tables.
 //!
@@ -15,6 +17,7 @@
 //! line to `verti-cli` (`verti sim compare`).
 
 pub mod divergence;
+pub mod driver;
 pub mod error;
 pub mod markdown;
 pub mod reference;
@@ -24,6 +27,6 @@ pub mod summary;
 
 pub use error::{CompareError, Result};
 pub use reference::{RefOutcome, RefTask, Reference, Sample, read_reference};
-pub use run::{CompareSetup, VertiRun, load_worlds, reference_episode, run_tasks};
+pub use run::{CompareSetup, Driver, VertiRun, load_worlds, reference_episode, run_tasks};
 pub use select::select_tasks;
 pub use summary::{Summary, TaskComparison, compare_task, summarize};

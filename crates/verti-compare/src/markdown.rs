@@ -3,7 +3,7 @@
 
 use crate::summary::{Aggregate, OutcomeCounts, Summary, TaskComparison};
 use std::fmt::Write;
-use verti_bench::Outcome;
+use verti_bench::{Outcome, Rules};
 
 /// Display name of the reference engine: `chrono-9.0.1` → `Chrono`.
 pub fn engine_label(engine: &str) -> String {
@@ -52,16 +52,25 @@ pub fn markdown(s: &Summary) -> String {
     let r = engine_label(&s.engine);
     let mut out = String::new();
     let st = &s.setup;
+    let gain = if st.system == "pid" {
+        format!(", kp {}", st.kp)
+    } else {
+        String::new()
+    };
+    let rules = match st.rules {
+        Rules::Paper => "paper",
+        Rules::VertiBench => "verti-bench",
+    };
     let _ = writeln!(
         out,
-        "# verti vs {r} ({})\n\nverti: {} driven by PID (speed {} m/s, lookahead {} m, kp {}, rate {} Hz), {:?} rules, {} s, every patch {} with friction {}.\n",
+        "# verti vs {r} ({})\n\nverti: {} driven by {} (speed {} m/s, lookahead {} m{gain}, rate {} Hz, inner step {} ms), {rules} rules, {} s, every patch {} with friction {}. Ratios are verti / {r}; the attitude ratios of the first table are medians of the per-task ratios.\n",
         s.engine,
         st.vehicle,
+        st.system,
         st.speed,
         st.lookahead,
-        st.kp,
         st.rate,
-        st.rules,
+        1000.0 * st.inner_dt,
         st.max_time,
         st.surface,
         st.friction
@@ -81,21 +90,22 @@ pub fn markdown(s: &Summary) -> String {
             counts(&a.verti),
             opt(a.median_time_ratio, 3),
             a.common_successes,
-            num(a.mean_abs_roll.ratio, 2),
-            num(a.mean_abs_pitch.ratio, 2),
+            opt(a.mean_abs_roll.median_ratio, 2),
+            opt(a.mean_abs_pitch.median_ratio, 2),
         );
     }
     let _ = writeln!(
         out,
-        "\n## Attitude (degrees, mean over tasks: {r} / verti, ratio)\n\n| | mean \\|roll\\| | max \\|roll\\| | mean \\|pitch\\| | max \\|pitch\\| |\n|---|---:|---:|---:|---:|"
+        "\n## Attitude (degrees, mean over tasks: {r} / verti (ratio of the means; median of the per-task ratios))\n\n| | mean \\|roll\\| | max \\|roll\\| | mean \\|pitch\\| | max \\|pitch\\| |\n|---|---:|---:|---:|---:|"
     );
     for a in &s.groups {
         let p = |x: &crate::summary::Paired| {
             format!(
-                "{} / {} ({})",
+                "{} / {} ({}; {})",
                 num(x.reference, 1),
                 num(x.verti, 1),
-                num(x.ratio, 2)
+                num(x.ratio_of_means, 2),
+                opt(x.median_ratio, 2)
             )
         };
         let _ = writeln!(

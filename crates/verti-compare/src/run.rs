@@ -7,9 +7,11 @@
 //! (e.g. starting the vehicle dropped from 1 m like the reference instead of settled) changes
 //! one function.
 
+use crate::driver::ReferenceDriver;
 use crate::error::{CompareError, Result};
 use crate::reference::{RefOutcome, Sample};
 use rayon::prelude::*;
+use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
@@ -32,10 +34,38 @@ pub const REFERENCE_FRICTION: f64 = 0.8;
 /// Period of the trajectory samples, s (the reference writes 10 Hz).
 pub const SAMPLE_PERIOD: f64 = 0.1;
 
+/// Which system drives verti's vehicle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Driver {
+    /// verti's PID with [`CompareSetup::pid`] (the reference README's "identical verti run").
+    #[default]
+    Pid,
+    /// The reference's own driver law ([`ReferenceDriver`]) at the PID's speed, lookahead and
+    /// rate, to see what the PID's differences from it change.
+    Reference,
+}
+
+impl Driver {
+    pub fn name(self) -> &'static str {
+        match self {
+            Driver::Pid => "pid",
+            Driver::Reference => "reference",
+        }
+    }
+    pub fn from_name(s: &str) -> Option<Driver> {
+        [Driver::Pid, Driver::Reference]
+            .into_iter()
+            .find(|d| d.name() == s)
+    }
+}
+
 /// How verti drives every compared task.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CompareSetup {
     pub vehicle: VehicleSpec,
+    pub driver: Driver,
+    /// PID parameters; the reference driver takes its speed, lookahead and rate from them.
     pub pid: PidParams,
     pub episode: EpisodeConfig,
     /// The class and surface every patch gets.
@@ -60,6 +90,7 @@ impl CompareSetup {
     pub fn reference(vehicle: VehicleSpec) -> CompareSetup {
         CompareSetup {
             vehicle,
+            driver: Driver::Pid,
             pid: PidParams {
                 speed: 3.0,
                 lookahead: 10.0,
@@ -144,7 +175,11 @@ pub struct VertiRun {
 
 /// Drives task `pair` of `world` (already prepared) as `setup` says.
 pub fn run_task(world: &Arc<World>, pair: u32, setup: &CompareSetup) -> VertiRun {
-    let mut system: Box<dyn MobilitySystem> = Box::new(Pid::new(setup.pid.clone()));
+    let p = &setup.pid;
+    let mut system: Box<dyn MobilitySystem> = match setup.driver {
+        Driver::Pid => Box::new(Pid::new(p.clone())),
+        Driver::Reference => Box::new(ReferenceDriver::new(p.speed, p.lookahead, p.rate)),
+    };
     let mut log = EpisodeLog::default();
     let result = run_episode(
         world,

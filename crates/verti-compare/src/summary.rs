@@ -126,12 +126,17 @@ impl OutcomeCounts {
     }
 }
 
-/// One quantity of both engines, averaged over tasks, and verti's over the reference's.
+/// One quantity of both engines over a group of tasks.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Paired {
+    /// Mean over the tasks.
     pub reference: f64,
     pub verti: f64,
-    pub ratio: f64,
+    /// verti's mean over the reference's. A few reference rollovers (|roll| to 90°) weigh
+    /// heavily in it.
+    pub ratio_of_means: f64,
+    /// Median over tasks of verti / reference per task: the typical task, the headline figure.
+    pub median_ratio: Option<f64>,
 }
 
 impl Paired {
@@ -141,7 +146,13 @@ impl Paired {
         Paired {
             reference,
             verti,
-            ratio: verti / reference,
+            ratio_of_means: verti / reference,
+            median_ratio: median(
+                tasks
+                    .iter()
+                    .map(|t| f(&t.verti) / f(&t.reference))
+                    .collect(),
+            ),
         }
     }
 }
@@ -235,6 +246,7 @@ pub struct SetupRecord {
     pub rate: f64,
     pub rules: verti_bench::Rules,
     pub max_time: f64,
+    /// Period of the benchmark's inner loop (speed controller, actions at most this often), s.
     pub inner_dt: f64,
     pub surface: String,
     pub friction: f64,
@@ -244,7 +256,10 @@ impl SetupRecord {
     pub fn of(setup: &CompareSetup) -> SetupRecord {
         SetupRecord {
             vehicle: setup.vehicle.name.clone(),
-            system: "pid".into(),
+            system: match setup.driver {
+                crate::run::Driver::Pid => "pid".into(),
+                crate::run::Driver::Reference => "reference driver".into(),
+            },
             speed: setup.pid.speed,
             lookahead: setup.pid.lookahead,
             kp: setup.pid.kp,
