@@ -123,8 +123,14 @@ pub fn load_worlds(
     setup: &CompareSetup,
 ) -> Result<BTreeMap<u32, Arc<World>>> {
     if !vb_dir.is_dir() {
+        // a relative default is easy to miss when running from elsewhere
+        let whence = if vb_dir.is_relative() {
+            " (relative to the current directory)"
+        } else {
+            ""
+        };
         return Err(CompareError::Argument(format!(
-            "{}: no such folder of Verti-Bench worlds (configN_LEVEL.yaml, worldN.bmp); give it with --vb-worlds",
+            "{}{whence}: no such folder of Verti-Bench worlds (configN_LEVEL.yaml, worldN.bmp); give it with --vb-worlds",
             vb_dir.display()
         )));
     }

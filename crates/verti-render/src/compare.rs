@@ -134,3 +134,77 @@ pub fn comparison_image(world: &World, page: &ComparePage) -> Result<RgbImage, R
 pub fn comparison_png(world: &World, page: &ComparePage, out: &Path) -> Result<(), RenderError> {
     save_png(&comparison_image(world, page)?, out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use verti_world::sets::resolve_world;
+
+    fn run(name: &str, offset: f64, world: &World) -> RunTrace {
+        // along the first task's straight line from start to goal, shifted sideways
+        let t = &world.tasks[0];
+        let (dx, dy) = (t.goal[0] - t.start[0], t.goal[1] - t.start[1]);
+        let n = 50;
+        let len = dx.hypot(dy);
+        let times: Vec<f64> = (0..n).map(|k| 0.1 * f64::from(k)).collect();
+        RunTrace {
+            name: name.into(),
+            label: format!("{name}: success"),
+            points: (0..n)
+                .map(|k| {
+                    let s = f64::from(k) / f64::from(n - 1);
+                    [
+                        t.start[0] + s * dx - offset * dy / len,
+                        t.start[1] + s * dy + offset * dx / len,
+                    ]
+                })
+                .collect(),
+            roll: times.iter().map(|t| 10.0 * t.sin() + offset).collect(),
+            pitch: times.iter().map(|t| 5.0 * t.cos()).collect(),
+            times,
+        }
+    }
+
+    #[test]
+    fn page_shows_both_tracks_and_charts() {
+        let world = resolve_world("verti-1:1", 1.0).unwrap();
+        let page = ComparePage {
+            title: "world 1 pair 0".into(),
+            pair: 0,
+            runs: vec![run("A", -6.0, &world), run("B", 6.0, &world)],
+            roll_marks: vec![-30.0, 30.0],
+            pixels_per_cell: 2,
+        };
+        let img = comparison_image(&world, &page).unwrap();
+        let map = render_world(
+            &world,
+            &RenderOptions {
+                pixels_per_cell: 2,
+                pairs: Some(vec![0]),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(img.width(), map.image.width() + CHART_WIDTH);
+        assert!(img.height() >= HEADER + 2 * MIN_CHART_HEIGHT);
+        // each track's colour at the middle of its line on the map
+        for (i, r) in page.runs.iter().enumerate() {
+            let [x, y] = r.points[25];
+            let (px, py) = map.map.to_pixel(x, y);
+            let p = img.get_pixel(px as u32, py as u32 + HEADER);
+            assert_eq!(*p, series_color(i), "run {i} at ({px}, {py})");
+        }
+        // and both colours in the chart column
+        let charts: Vec<_> = (map.image.width()..img.width())
+            .flat_map(|x| (HEADER..img.height()).map(move |y| (x, y)))
+            .map(|(x, y)| *img.get_pixel(x, y))
+            .collect();
+        for i in 0..2 {
+            assert!(charts.contains(&series_color(i)), "run {i} not charted");
+        }
+        let mut bad = page.clone();
+        bad.runs[1].roll.pop();
+        let e = comparison_image(&world, &bad).unwrap_err().to_string();
+        assert!(e.contains("run B: 50 times, 50 points, 49 roll"), "{e}");
+    }
+}
