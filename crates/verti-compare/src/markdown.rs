@@ -1,6 +1,7 @@
 //! The comparison as Markdown: the headline table in the layout of the reference's README,
 //! then attitudes and divergence per group, the outcome confusion, and one row per task.
 
+use crate::run::Driver;
 use crate::summary::{Aggregate, OutcomeCounts, Summary, TaskComparison};
 use std::fmt::Write;
 use verti_bench::{Outcome, Rules};
@@ -52,10 +53,9 @@ pub fn markdown(s: &Summary) -> String {
     let r = engine_label(&s.engine);
     let mut out = String::new();
     let st = &s.setup;
-    let gain = if st.system == "pid" {
-        format!(", kp {}", st.kp)
-    } else {
-        String::new()
+    let (driver, gain) = match st.driver {
+        Driver::Pid => ("PID", format!(", kp {}", st.kp)),
+        Driver::Reference => ("the reference's driver law", String::new()),
     };
     let rules = match st.rules {
         Rules::Paper => "paper",
@@ -63,10 +63,9 @@ pub fn markdown(s: &Summary) -> String {
     };
     let _ = writeln!(
         out,
-        "# verti vs {r} ({})\n\nverti: {} driven by {} (speed {} m/s, lookahead {} m{gain}, rate {} Hz, inner step {} ms), {rules} rules, {} s, every patch {} with friction {}. Ratios are verti / {r}; the attitude ratios of the first table are medians of the per-task ratios.\n",
+        "# verti vs {r} ({})\n\nverti: {} driven by {driver} (speed {} m/s, lookahead {} m{gain}, rate {} Hz, inner step {} ms), {rules} rules, {} s, every patch {} with friction {}. Ratios are verti / {r}; the attitude ratios of the first table are medians of the per-task ratios.\n",
         s.engine,
         st.vehicle,
-        st.system,
         st.speed,
         st.lookahead,
         st.rate,

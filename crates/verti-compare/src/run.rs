@@ -27,7 +27,9 @@ use verti_world::{Surface, TerrainClass, World};
 /// commands a road-wheel angle of `kp · error` scaled by the maximum angle, so the same law is
 /// `kp` = the HMMWV's maximum road-wheel angle, 0.5276 rad (30.23°).
 pub const REFERENCE_KP: f64 = 0.5276;
-/// The reference's driver acts every 5 ms physics step.
+/// The reference's driver acts every 5 ms physics step. A system acts at most once per inner
+/// step of the benchmark's loop, 10 ms by default (`EpisodeConfig::inner_dt`), so at that
+/// default this rate acts every 10 ms, exactly as rate 100 would.
 pub const REFERENCE_RATE: f64 = 200.0;
 /// Friction of every patch in the reference runs.
 pub const REFERENCE_FRICTION: f64 = 0.8;

@@ -239,7 +239,7 @@ fn aggregate(group: &str, tasks: &[&TaskComparison]) -> Aggregate {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SetupRecord {
     pub vehicle: String,
-    pub system: String,
+    pub driver: crate::run::Driver,
     pub speed: f64,
     pub lookahead: f64,
     pub kp: f64,
@@ -256,10 +256,7 @@ impl SetupRecord {
     pub fn of(setup: &CompareSetup) -> SetupRecord {
         SetupRecord {
             vehicle: setup.vehicle.name.clone(),
-            system: match setup.driver {
-                crate::run::Driver::Pid => "pid".into(),
-                crate::run::Driver::Reference => "reference driver".into(),
-            },
+            driver: setup.driver,
             speed: setup.pid.speed,
             lookahead: setup.pid.lookahead,
             kp: setup.pid.kp,
