@@ -1,5 +1,6 @@
 //! `verti`: the command line of the verti off-road mobility benchmark.
 
+mod compare_cmd;
 mod eval_cmd;
 mod progress;
 mod registries;
@@ -27,7 +28,7 @@ enum Command {
     /// List and inspect vehicles.
     #[command(subcommand)]
     Vehicle(vehicle_cmd::VehicleCommand),
-    /// Simulator speed benchmark and robustness soak.
+    /// Simulator speed benchmark, robustness soak, and comparison with a reference engine.
     #[command(subcommand)]
     Sim(vehicle_cmd::SimCommand),
     /// List the mobility systems and their parameters.

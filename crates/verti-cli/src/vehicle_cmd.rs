@@ -85,6 +85,9 @@ pub enum SimCommand {
     Bench(BenchArgs),
     /// Random inputs through every world of a set; reports NaNs and blow-ups.
     Soak(SoakArgs),
+    /// Fidelity: re-run a reference engine's tasks (e.g. ../shared/chrono-reference) in verti
+    /// and compare outcomes, attitudes, times and trajectories; a PNG per task and a summary.
+    Compare(crate::compare_cmd::CompareArgs),
 }
 
 #[derive(Args)]
@@ -143,6 +146,7 @@ pub fn run_sim(cmd: SimCommand) -> CmdResult {
             }
             Ok(())
         }
+        SimCommand::Compare(a) => crate::compare_cmd::compare(a),
         SimCommand::Soak(a) => {
             let specs = vehicles_arg(&a.vehicle)?;
             let set = load_set_with_progress(&a.worlds, 1.0)?;

@@ -195,7 +195,7 @@ fn axis(panel: &Panel) -> (f64, f64, f64) {
 }
 
 /// The smallest of 1, 2, 2.5, 5 (times a power of ten) not below `raw`.
-fn nice_step(raw: f64) -> f64 {
+pub(crate) fn nice_step(raw: f64) -> f64 {
     if !(raw.is_finite() && raw > 0.0) {
         return 1.0;
     }
@@ -209,7 +209,7 @@ fn nice_step(raw: f64) -> f64 {
 }
 
 /// Decimals needed to print multiples of `step` exactly.
-fn decimals(step: f64) -> usize {
+pub(crate) fn decimals(step: f64) -> usize {
     (0..=6)
         .find(|&d| {
             let x = step * 10f64.powi(d as i32);

@@ -11,24 +11,30 @@
 //!   level (the paper's Fig. 2 bottom).
 //! * [`grouped_bars_png`]: grouped bar charts in a grid with one colour per series, like the
 //!   paper's Fig. 6 (see [`charts`]).
+//! * [`lines`]: line charts of series over a shared axis (e.g. roll over time).
+//! * [`comparison_png`]: several runs of one task side by side: their tracks over the map
+//!   ([`draw_track`], one colour each) and their roll and pitch over time.
 //!
 //! Shapes are rasterised here with analytic anti-aliasing (coverage from the signed distance
 //! to each shape); text goes through `plotters` with a vendored DejaVu Sans so output does not
 //! depend on the fonts of the machine.
 
 pub mod charts;
+mod compare;
 mod draw;
 mod glyphs;
 mod histogram;
+pub mod lines;
 mod map;
 pub mod palette;
 
 pub use charts::{Panel, Series, grouped_bars_image, grouped_bars_png};
+pub use compare::{ComparePage, RunTrace, comparison_image, comparison_png};
 pub use draw::save_png;
 pub use histogram::{elevation_histograms_image, elevation_histograms_png};
 pub use map::{
-    MAX_PIXELS_PER_CELL, MapTransform, RenderOptions, TrajectoryStyle, WorldImage, draw_trajectory,
-    render_world, render_world_png,
+    MAX_PIXELS_PER_CELL, MapTransform, RenderOptions, TrajectoryStyle, WorldImage, draw_track,
+    draw_trajectory, render_world, render_world_png,
 };
 
 use std::path::PathBuf;

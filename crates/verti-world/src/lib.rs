@@ -17,6 +17,7 @@ pub mod scale;
 pub mod sets;
 pub mod stats;
 pub mod surface;
+pub mod uniform;
 pub mod world;
 pub mod yaml;
 

@@ -9,13 +9,16 @@
 //! * `legend`: which legend rows a world gets, and the scale-bar length and labels.
 //! * `markers`: start/goal markers and their pair numbers.
 //! * `trajectory`: [`draw_trajectory`], a speed-coloured run drawn over a finished render.
+//! * `overlay`: [`draw_track`], a run in one colour with a legend row (several runs per map).
 
 mod legend;
 mod markers;
+mod overlay;
 mod render;
 mod shading;
 mod trajectory;
 
+pub use overlay::draw_track;
 pub use render::{render_world, render_world_png};
 pub use trajectory::{TrajectoryStyle, draw_trajectory};
 

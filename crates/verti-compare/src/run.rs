@@ -1,0 +1,266 @@
+//! Re-running reference tasks in verti, set up as the reference describes ("The identical
+//! verti run" in `chrono-reference/README.md`): the imported world with one rigid surface
+//! everywhere, verti's PID with the reference's steering law, paper rules, 60 s.
+//!
+//! Every setting lives in [`CompareSetup`], built in one place ([`CompareSetup::reference`]);
+//! the episode settings in particular come only from [`reference_episode`], so a later option
+//! (e.g. starting the vehicle dropped from 1 m like the reference instead of settled) changes
+//! one function.
+
+use crate::driver::ReferenceDriver;
+use crate::error::{CompareError, Result};
+use crate::reference::{RefOutcome, Sample};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Arc;
+use verti_bench::episode::{EpisodeLog, StepRecord};
+use verti_bench::{EpisodeConfig, Feature, MobilitySystem, Rules, TrialResult, run_episode};
+use verti_sim::VehicleSpec;
+use verti_systems::pid::{Pid, PidParams};
+use verti_world::import_vb::{ImportOptions, import_vb, scan_vb_dir};
+use verti_world::surface::RIGID_RESTITUTION;
+use verti_world::{Surface, TerrainClass, World};
+
+/// The reference writes the heading error (rad) straight into the steering input; verti's PID
+/// commands a road-wheel angle of `kp · error` scaled by the maximum angle, so the same law is
+/// `kp` = the HMMWV's maximum road-wheel angle, 0.5276 rad (30.23°).
+pub const REFERENCE_KP: f64 = 0.5276;
+/// The reference's driver acts every 5 ms physics step. A system acts at most once per inner
+/// step of the benchmark's loop, 10 ms by default (`EpisodeConfig::inner_dt`), so at that
+/// default this rate acts every 10 ms, exactly as rate 100 would.
+pub const REFERENCE_RATE: f64 = 200.0;
+/// Friction of every patch in the reference runs.
+pub const REFERENCE_FRICTION: f64 = 0.8;
+/// Period of the trajectory samples, s (the reference writes 10 Hz).
+pub const SAMPLE_PERIOD: f64 = 0.1;
+
+/// Which system drives verti's vehicle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Driver {
+    /// verti's PID with [`CompareSetup::pid`] (the reference README's "identical verti run").
+    #[default]
+    Pid,
+    /// The reference's own driver law ([`ReferenceDriver`]) at the PID's speed, lookahead and
+    /// rate, to see what the PID's differences from it change.
+    Reference,
+}
+
+impl Driver {
+    pub fn name(self) -> &'static str {
+        match self {
+            Driver::Pid => "pid",
+            Driver::Reference => "reference",
+        }
+    }
+    pub fn from_name(s: &str) -> Option<Driver> {
+        [Driver::Pid, Driver::Reference]
+            .into_iter()
+            .find(|d| d.name() == s)
+    }
+}
+
+/// How verti drives every compared task.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompareSetup {
+    pub vehicle: VehicleSpec,
+    pub driver: Driver,
+    /// PID parameters; the reference driver takes its speed, lookahead and rate from them.
+    pub pid: PidParams,
+    pub episode: EpisodeConfig,
+    /// The class and surface every patch gets.
+    pub class: TerrainClass,
+    pub surface: Surface,
+}
+
+/// The episode settings of every compared trial: paper rules, 60 s, verti's default inner
+/// loop and start (settled on the ground).
+pub fn reference_episode() -> EpisodeConfig {
+    EpisodeConfig {
+        rules: Rules::Paper,
+        max_time: 60.0,
+        ..Default::default()
+    }
+}
+
+impl CompareSetup {
+    /// The setup of the reference's README for `vehicle`: rigid dirt with friction 0.8 and
+    /// restitution 0.01 everywhere; PID at 3 m/s, lookahead 10 m, kp [`REFERENCE_KP`], rate
+    /// [`REFERENCE_RATE`]; [`reference_episode`].
+    pub fn reference(vehicle: VehicleSpec) -> CompareSetup {
+        CompareSetup {
+            vehicle,
+            driver: Driver::Pid,
+            pid: PidParams {
+                speed: 3.0,
+                lookahead: 10.0,
+                kp: REFERENCE_KP,
+                ki: 0.0,
+                kd: 0.0,
+                rate: REFERENCE_RATE,
+            },
+            episode: reference_episode(),
+            class: TerrainClass::Dirt,
+            surface: Surface::Rigid {
+                friction: REFERENCE_FRICTION,
+                restitution: RIGID_RESTITUTION,
+            },
+        }
+    }
+
+    /// The world as the comparison drives it: `world` with the setup's surface everywhere.
+    pub fn prepare(&self, world: &World) -> Result<World> {
+        Ok(world.with_uniform_surface(self.class, self.surface)?)
+    }
+}
+
+/// Imports the Verti-Bench worlds the tasks name from `vb_dir` (once each, in parallel) and
+/// prepares them with `setup`. Each must be the world the reference names (`vb/configN_LEVEL`
+/// for world index N), or the task's line is reported.
+pub fn load_worlds(
+    vb_dir: &Path,
+    tasks: &[&RefOutcome],
+    setup: &CompareSetup,
+) -> Result<BTreeMap<u32, Arc<World>>> {
+    if !vb_dir.is_dir() {
+        // a relative default is easy to miss when running from elsewhere
+        let whence = if vb_dir.is_relative() {
+            " (relative to the current directory)"
+        } else {
+            ""
+        };
+        return Err(CompareError::Argument(format!(
+            "{}{whence}: no such folder of Verti-Bench worlds (configN_LEVEL.yaml, worldN.bmp); give it with --vb-worlds",
+            vb_dir.display()
+        )));
+    }
+    let files = scan_vb_dir(vb_dir)?;
+    let mut wanted: BTreeMap<u32, &RefOutcome> = BTreeMap::new();
+    for t in tasks {
+        wanted.entry(t.world_index).or_insert(t);
+    }
+    let jobs: Vec<(u32, &RefOutcome)> = wanted.into_iter().collect();
+    let worlds = jobs
+        .par_iter()
+        .map(|&(index, first)| {
+            let f = files.iter().find(|f| f.index == index).ok_or_else(|| {
+                CompareError::Argument(format!(
+                    "{}: no world {index} (reference world `{}`, outcomes line {})",
+                    vb_dir.display(),
+                    first.world,
+                    first.line
+                ))
+            })?;
+            let world = import_vb(
+                &f.config,
+                &f.heightmap,
+                f.labels.as_deref(),
+                &ImportOptions::default(),
+            )?;
+            if world.meta.name != first.world {
+                return Err(CompareError::Argument(format!(
+                    "{}: world {index} is `{}`, but the reference names `{}` (outcomes line {})",
+                    f.config.display(),
+                    world.meta.name,
+                    first.world,
+                    first.line
+                )));
+            }
+            Ok((index, Arc::new(setup.prepare(&world)?)))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(worlds.into_iter().collect())
+}
+
+/// One task driven by verti: the trial's record and its 10 Hz trajectory.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VertiRun {
+    pub result: TrialResult,
+    pub samples: Vec<Sample>,
+}
+
+/// Drives task `pair` of `world` (already prepared) as `setup` says.
+pub fn run_task(world: &Arc<World>, pair: u32, setup: &CompareSetup) -> VertiRun {
+    let p = &setup.pid;
+    let mut system: Box<dyn MobilitySystem> = match setup.driver {
+        Driver::Pid => Box::new(Pid::new(p.clone())),
+        Driver::Reference => Box::new(ReferenceDriver::new(p.speed, p.lookahead, p.rate)),
+    };
+    let mut log = EpisodeLog::default();
+    let result = run_episode(
+        world,
+        &setup.vehicle,
+        pair,
+        system.as_mut(),
+        &setup.episode,
+        Some(&mut log),
+    );
+    VertiRun {
+        result,
+        samples: resample(&log.steps, SAMPLE_PERIOD),
+    }
+}
+
+/// Runs `tasks` (world index, pair) on `jobs` threads; the results are in the order of
+/// `tasks` and do not depend on `jobs`. `done` is called after each task.
+pub fn run_tasks(
+    worlds: &BTreeMap<u32, Arc<World>>,
+    tasks: &[(u32, u32)],
+    setup: &CompareSetup,
+    jobs: usize,
+    done: &(dyn Fn() + Sync),
+) -> Result<Vec<VertiRun>> {
+    for (w, _) in tasks {
+        if !worlds.contains_key(w) {
+            return Err(CompareError::Argument(format!("world {w} was not loaded")));
+        }
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.max(1))
+        .build()
+        .map_err(|e| CompareError::Argument(format!("cannot start {jobs} threads: {e}")))?;
+    Ok(pool.install(|| {
+        tasks
+            .par_iter()
+            .map(|&(w, pair)| {
+                let run = run_task(&worlds[&w], pair, setup);
+                done();
+                run
+            })
+            .collect()
+    }))
+}
+
+/// Samples of a step log every `period` seconds (the first step at or after each multiple), as
+/// the reference writes them.
+pub fn resample(steps: &[StepRecord], period: f64) -> Vec<Sample> {
+    let get = |s: &StepRecord, f: Feature| s.get(f).unwrap_or(f64::NAN);
+    let mut out = Vec::new();
+    let mut k = 1u32;
+    for s in steps {
+        let t = s.t();
+        if t + 1e-9 < f64::from(k) * period {
+            continue;
+        }
+        while f64::from(k) * period <= t + 1e-9 {
+            k += 1;
+        }
+        out.push(Sample {
+            t,
+            x: get(s, Feature::X),
+            y: get(s, Feature::Y),
+            z: get(s, Feature::Z),
+            roll: get(s, Feature::Roll).to_degrees(),
+            pitch: get(s, Feature::Pitch).to_degrees(),
+            yaw: get(s, Feature::Yaw).to_degrees(),
+            v: get(s, Feature::Vx),
+            steer: get(s, Feature::Steering),
+            throttle: get(s, Feature::Throttle),
+            brake: get(s, Feature::Brake),
+            agl: f64::NAN,
+        });
+    }
+    out
+}
