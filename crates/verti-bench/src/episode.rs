@@ -30,6 +30,39 @@ pub enum Rules {
     VertiBench,
 }
 
+/// How a trial's vehicle starts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StartMode {
+    /// Settled on the ground at rest (springs and tyres at their static load, body fitted to
+    /// the terrain under the wheels): the trial measures driving, not landing. The default,
+    /// with either rules; the paper does not describe its spawn.
+    #[default]
+    Settled,
+    /// Verti-Bench's spawn: level, the chassis reference frame 1 m (scaled) above the ground,
+    /// dropped at t = 0 (its reference code, `vehicles/HMMWV.py`). Used to compare with it: on
+    /// steep ground the landing alone can tip a vehicle over.
+    Drop,
+}
+
+impl StartMode {
+    /// Verti-Bench's drop height at full scale, metres.
+    pub const DROP_HEIGHT: f64 = 1.0;
+
+    pub fn name(self) -> &'static str {
+        match self {
+            StartMode::Settled => "settled",
+            StartMode::Drop => "drop",
+        }
+    }
+
+    pub fn from_name(s: &str) -> Option<StartMode> {
+        [StartMode::Settled, StartMode::Drop]
+            .into_iter()
+            .find(|m| m.name() == s)
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct EpisodeConfig {
     pub rules: Rules,
@@ -53,6 +86,8 @@ pub struct EpisodeConfig {
     pub log_seconds: Option<f64>,
     /// Run seed; each trial's system seed is derived from it and the task.
     pub seed: u64,
+    /// How the vehicle starts.
+    pub start: StartMode,
 }
 
 impl Default for EpisodeConfig {
@@ -68,6 +103,7 @@ impl Default for EpisodeConfig {
             inner_dt: 0.01,
             log_seconds: None,
             seed: 0,
+            start: StartMode::Settled,
         }
     }
 }

@@ -323,6 +323,7 @@ pub fn evaluate(
         &setup.run,
         setup.worlds,
         setup.vehicle,
+        setup.episode.start,
         setup.step_log.as_ref().map(|s| s.seconds),
     );
 

@@ -7,6 +7,7 @@
 //! of the world set's contents and of the vehicle spec next to the names, and a resume that
 //! differs is refused with the settings that differ, one by one.
 
+use crate::episode::StartMode;
 use crate::eval::{EvalError, RunInfo};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -83,6 +84,9 @@ pub struct RunRecord {
     /// has moved or changed (absent in runs recorded before digests).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub vehicle_spec: Option<VehicleSpec>,
+    /// How each trial's vehicle starts (runs recorded before the option started settled).
+    #[serde(default)]
+    pub start: StartMode,
     /// Per-step logs kept ([`step_log_label`]); `None` when the run keeps none.
     #[serde(default)]
     pub step_log: Option<String>,
@@ -98,6 +102,7 @@ impl RunRecord {
         run: &RunInfo,
         worlds: &[Arc<World>],
         vehicle: &VehicleSpec,
+        start: StartMode,
         step_log: Option<f64>,
     ) -> Self {
         RunRecord {
@@ -105,6 +110,7 @@ impl RunRecord {
             worlds_digest: Some(set_digest(worlds)),
             vehicle_digest: Some(vehicle_digest(vehicle)),
             vehicle_spec: Some(vehicle.clone()),
+            start,
             step_log: step_log_label(step_log),
             tasks: None,
         }
@@ -171,6 +177,11 @@ impl RunRecord {
         differ("rules", json(&a.rules), json(&b.rules));
         differ("seed", a.seed.to_string(), b.seed.to_string());
         differ("max_time", a.max_time.to_string(), b.max_time.to_string());
+        differ(
+            "start",
+            recorded.start.name().to_string(),
+            self.start.name().to_string(),
+        );
         differ(
             "step logs",
             recorded.step_log.clone().unwrap_or("none".into()),

@@ -28,7 +28,9 @@ pub mod speed;
 pub mod system;
 pub mod trial;
 
-pub use episode::{EpisodeConfig, Outcome, Rules, Termination, TrialResult, run_episode};
+pub use episode::{
+    EpisodeConfig, Outcome, Rules, StartMode, Termination, TrialResult, run_episode,
+};
 pub use features::{Feature, FeatureSource};
 pub use observation::{Crop, CropSpec, Observation};
 pub use system::{Action, MobilitySystem, SystemFactory, SystemInfo, SystemRegistry, TaskInfo};

@@ -7,7 +7,9 @@
 //! branching rollouts. The inner loop (speed controller, physics, pose, metrics, termination
 //! rules, step log) therefore exists once.
 
-use crate::episode::{EpisodeConfig, EpisodeLog, Outcome, StepRecord, Termination, TrialResult};
+use crate::episode::{
+    EpisodeConfig, EpisodeLog, Outcome, StartMode, StepRecord, Termination, TrialResult,
+};
 use crate::features::{FeatureSource, STEP_LOG};
 use crate::metrics::{AngleStats, SignalStats};
 use crate::observation::{Observation, Pose6};
@@ -167,13 +169,12 @@ impl Trial {
             .iter()
             .find(|t| t.pair == pair)
             .expect("task_info found it");
-        let state = sim
-            .state_at(StartPose::new(
-                task.start[0],
-                task.start[1],
-                task.start_yaw(),
-            ))
-            .map_err(|e| format!("cannot start the simulation: {e}"))?;
+        let start = StartPose::new(task.start[0], task.start[1], task.start_yaw());
+        let state = match cfg.start {
+            StartMode::Settled => sim.state_at(start),
+            StartMode::Drop => sim.state_dropped(start, StartMode::DROP_HEIGHT * world.meta.scale),
+        }
+        .map_err(|e| format!("cannot start the simulation: {e}"))?;
         let pose = pose6(&sim, &state);
         let rules = Termination::new(world, task.goal, cfg, &pose);
         let result = blank_result(world, &spec.name, pair, system, cfg);

@@ -52,6 +52,15 @@ pub struct CompareArgs {
     /// often). Default: the benchmark's 0.01; the reference steps every 0.005.
     #[arg(long)]
     inner_dt: Option<f64>,
+    /// How verti's vehicle starts: `drop` (default: the reference's spawn, level and 1 m above
+    /// the ground) or `settled` (the benchmark's default, at rest on the ground).
+    #[arg(long, default_value = "drop", value_parser = parse_start)]
+    start: verti_bench::StartMode,
+}
+
+fn parse_start(s: &str) -> Result<verti_bench::StartMode, String> {
+    use verti_bench::StartMode;
+    StartMode::from_name(s).ok_or_else(|| format!("unknown start `{s}`: use drop or settled"))
 }
 
 fn parse_driver(s: &str) -> Result<Driver, String> {
@@ -71,6 +80,7 @@ pub fn compare(a: CompareArgs) -> CmdResult {
     }
     let mut setup = CompareSetup::reference(vehicle);
     setup.driver = a.driver;
+    setup.episode.start = a.start;
     if let Some(dt) = a.inner_dt {
         setup.episode.inner_dt = dt;
     }

@@ -6,7 +6,7 @@ use crate::world_cmd::{CmdResult, ScaleArg, ensure_parent, load_set_checked};
 use clap::Args;
 use std::path::PathBuf;
 use std::sync::Arc;
-use verti_bench::episode::{EpisodeLog, Outcome, Rules};
+use verti_bench::episode::{EpisodeLog, Outcome, Rules, StartMode};
 use verti_bench::eval::{EvalSetup, RUN_FILE, RunInfo, evaluate, parse_tasks, read_results};
 use verti_bench::identity::RunRecord;
 use verti_bench::{EpisodeConfig, run_episode};
@@ -24,6 +24,10 @@ pub fn assignment(s: &str) -> Result<String, String> {
     } else {
         Err(format!("parameter `{s}` must look like name=value"))
     }
+}
+
+fn parse_start(s: &str) -> Result<StartMode, String> {
+    StartMode::from_name(s).ok_or_else(|| format!("unknown start `{s}`: use settled or drop"))
 }
 
 fn parse_rules(s: &str) -> Result<Rules, String> {
@@ -72,6 +76,10 @@ pub struct EvalArgs {
     /// Time limit per trial, simulated seconds.
     #[arg(long, default_value_t = 60.0)]
     max_time: f64,
+    /// How the vehicle starts: settled on the ground (default), or drop (Verti-Bench's spawn:
+    /// level, 1 m above the ground, scaled, and dropped).
+    #[arg(long, default_value = "settled", value_parser = parse_start)]
+    start: StartMode,
     /// Run seed (systems with randomness derive their per-task seed from it).
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -121,6 +129,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         rules: a.rules,
         max_time: a.max_time,
         seed: a.seed,
+        start: a.start,
         ..Default::default()
     };
     let warn = |m: &str| eprintln!("warning: {m}");
@@ -283,6 +292,7 @@ pub fn replay(a: ReplayArgs) -> CmdResult {
         rules: run.rules,
         max_time: run.max_time,
         seed: run.seed,
+        start: record.start,
         log_seconds: Some(f64::INFINITY),
         ..Default::default()
     };

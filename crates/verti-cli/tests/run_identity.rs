@@ -154,6 +154,12 @@ fn step_logs_belong_to_the_run() {
     // a fresh start keeps no stale logs
     ok(&eval_args("verti-1", out_s, &["--force"]), None);
     assert!(!out.join("steps").exists());
+    // how trials start is part of the run too
+    let e = err(
+        &eval_args("verti-1", out_s, &["--resume", "--start", "drop"]),
+        None,
+    );
+    assert!(e.contains("start: settled recorded, drop now"), "{e}");
 }
 
 #[test]

@@ -63,13 +63,14 @@ pub fn markdown(s: &Summary) -> String {
     };
     let _ = writeln!(
         out,
-        "# verti vs {r} ({})\n\nverti: {} driven by {driver} (speed {} m/s, lookahead {} m{gain}, rate {} Hz, inner step {} ms), {rules} rules, {} s, every patch {} with friction {}. Ratios are verti / {r}; the attitude ratios of the first table are medians of the per-task ratios.\n",
+        "# verti vs {r} ({})\n\nverti: {} driven by {driver} (speed {} m/s, lookahead {} m{gain}, rate {} Hz, inner step {} ms), {} start, {rules} rules, {} s, every patch {} with friction {}. Ratios are verti / {r}; the attitude ratios of the first table are medians of the per-task ratios.\n",
         s.engine,
         st.vehicle,
         st.speed,
         st.lookahead,
         st.rate,
         1000.0 * st.inner_dt,
+        st.start.name(),
         st.max_time,
         st.surface,
         st.friction

@@ -16,7 +16,9 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 use verti_bench::episode::{EpisodeLog, StepRecord};
-use verti_bench::{EpisodeConfig, Feature, MobilitySystem, Rules, TrialResult, run_episode};
+use verti_bench::{
+    EpisodeConfig, Feature, MobilitySystem, Rules, StartMode, TrialResult, run_episode,
+};
 use verti_sim::VehicleSpec;
 use verti_systems::pid::{Pid, PidParams};
 use verti_world::import_vb::{ImportOptions, import_vb, scan_vb_dir};
@@ -76,11 +78,12 @@ pub struct CompareSetup {
 }
 
 /// The episode settings of every compared trial: paper rules, 60 s, verti's default inner
-/// loop and start (settled on the ground).
+/// loop, and the reference's start (level, 1 m above the ground, dropped).
 pub fn reference_episode() -> EpisodeConfig {
     EpisodeConfig {
         rules: Rules::Paper,
         max_time: 60.0,
+        start: StartMode::Drop,
         ..Default::default()
     }
 }

@@ -248,6 +248,8 @@ pub struct SetupRecord {
     pub max_time: f64,
     /// Period of the benchmark's inner loop (speed controller, actions at most this often), s.
     pub inner_dt: f64,
+    /// How verti's vehicle starts (`drop`: the reference's spawn).
+    pub start: verti_bench::StartMode,
     pub surface: String,
     pub friction: f64,
 }
@@ -264,6 +266,7 @@ impl SetupRecord {
             rules: setup.episode.rules,
             max_time: setup.episode.max_time,
             inner_dt: setup.episode.inner_dt,
+            start: setup.episode.start,
             surface: setup.class.to_string(),
             friction: setup.surface.effective_friction(),
         }

@@ -5,7 +5,7 @@
 use crate::error::SimError;
 use crate::model::{GRAVITY, Model};
 use crate::spec::VehicleSpec;
-use crate::start::{seat, state_at_rest};
+use crate::start::{dropped, seat, state_at_rest};
 use crate::state::{Pose, SimState, StartPose};
 use crate::terrain::Terrain;
 use std::sync::Arc;
@@ -50,6 +50,20 @@ impl Sim {
     pub fn state_at(&self, start: StartPose) -> Result<SimState, SimError> {
         let pose = seat(&self.terrain.world, &self.spec, start)?;
         state_at_rest(&self.model, &self.spec, &self.terrain, pose)
+    }
+
+    /// The state of Verti-Bench's spawn at `start`: level, the chassis reference frame
+    /// `height` above the ground, at rest, springs at their static compression and tyres
+    /// undeflected, ready to fall onto the terrain (see `start::dropped`).
+    pub fn state_dropped(&self, start: StartPose, height: f64) -> Result<SimState, SimError> {
+        let pose = dropped(&self.terrain.world, &self.spec, start, height)?;
+        let mut state = state_at_rest(&self.model, &self.spec, &self.terrain, pose)?;
+        // in the air no tyre is wound up against a slope
+        for w in &mut state.wheels {
+            w.slip_long = 0.0;
+            w.slip_lat = 0.0;
+        }
+        Ok(state)
     }
 
     pub fn world(&self) -> &Arc<World> {

@@ -88,7 +88,55 @@ pub(crate) fn seat(world: &World, spec: &VehicleSpec, start: StartPose) -> Resul
         position: Vec3::new(x, y, z),
         orientation,
     };
-    // A start inside a rock or tree would be an explosion, not a drive.
+    check_clear(world, spec, pose, (x, y))?;
+    Ok(pose)
+}
+
+/// Verti-Bench's spawn: the chassis reference frame `height` above the ground at (x, y), level
+/// (no roll or pitch) and heading `yaw`, springs at their static compression, to be dropped.
+/// The HMMWV's reference frame is at its wheel centres, so a 1 m drop height leaves its tyres
+/// about 0.5 m in the air. Refuses a start off the map or inside an obstacle.
+pub(crate) fn dropped(
+    world: &World,
+    spec: &VehicleSpec,
+    start: StartPose,
+    height: f64,
+) -> Result<Pose, SimError> {
+    let StartPose { x, y, yaw } = start;
+    if !(x.is_finite() && y.is_finite() && yaw.is_finite()) {
+        return Err(SimError::InvalidStart(format!(
+            "({x}, {y}, yaw {yaw}) is not finite"
+        )));
+    }
+    if !(height.is_finite() && height >= 0.0) {
+        return Err(SimError::InvalidStart(format!(
+            "drop height {height} must be a finite number of metres, at least 0"
+        )));
+    }
+    if !world.terrain.contains(x, y) {
+        return Err(SimError::InvalidStart(format!(
+            "({x:.2}, {y:.2}) is off the map (half extent {:.2} m)",
+            world.terrain.half_extent()
+        )));
+    }
+    let pose = Pose {
+        position: Vec3::new(x, y, world.terrain.height_at(x, y) + height),
+        orientation: quat_from_euler(0.0, 0.0, yaw),
+    };
+    check_clear(world, spec, pose, (x, y))?;
+    Ok(pose)
+}
+
+/// Refuses a pose whose chassis box or wheels overlap an obstacle: a start inside a rock or
+/// tree would be an explosion, not a drive.
+fn check_clear(
+    world: &World,
+    spec: &VehicleSpec,
+    pose: Pose,
+    (x, y): (f64, f64),
+) -> Result<(), SimError> {
+    let orientation = pose.orientation;
+    let comp = static_compressions(spec);
     let bx = &spec.chassis.collision_box;
     let (c, half) = (
         Vec3::new(bx.center[0], bx.center[1], bx.center[2]),
@@ -125,7 +173,7 @@ pub(crate) fn seat(world: &World, spec: &VehicleSpec, start: StartPose) -> Resul
             }
         }
     }
-    Ok(pose)
+    Ok(())
 }
 
 /// The state at rest with the chassis reference frame at `pose`, springs at their static

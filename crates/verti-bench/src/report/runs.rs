@@ -43,6 +43,7 @@ fn settings(r: &RunRecord) -> BTreeMap<String, String> {
     );
     put("seed", run.seed.to_string());
     put("max_time", run.max_time.to_string());
+    put("start", r.start.name().to_string());
     for (k, v) in run.params.iter() {
         put(k, v.to_string());
     }
