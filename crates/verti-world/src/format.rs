@@ -20,6 +20,7 @@ use crate::surface::{PATCHES_PER_SIDE, Patch, PatchGrid, SoilParams, Surface, Te
 use crate::world::{
     ElevationLevel, GlobalPath, ObstacleDensity, Task, TerrainType, World, WorldMeta, WorldSource,
 };
+use crate::yaml::{YamlLimits, read_yaml_bounded};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -257,7 +258,7 @@ pub fn load_world(path: &Path) -> Result<World> {
     } else {
         path.to_path_buf()
     };
-    let text = std::fs::read_to_string(&mpath).map_err(|e| WorldError::io(&mpath, e))?;
+    let text = read_yaml_bounded(&mpath, &YamlLimits::DEFAULT, "the world manifest")?;
     let m: Manifest = serde_norway::from_str(&text).map_err(|e| {
         let msg = e.to_string();
         let field = msg
@@ -647,7 +648,7 @@ pub fn save_set(
 /// Reads a set manifest.
 pub fn read_set_manifest(dir: &Path) -> Result<SetManifest> {
     let p = dir.join(SET_MANIFEST);
-    let text = std::fs::read_to_string(&p).map_err(|e| WorldError::io(&p, e))?;
+    let text = read_yaml_bounded(&p, &YamlLimits::DEFAULT, "the set manifest")?;
     let m: SetManifest = serde_norway::from_str(&text)
         .map_err(|e| WorldError::invalid(&p, "manifest", e.to_string()))?;
     if m.format != "verti-world-set" {

@@ -138,7 +138,11 @@ pub fn read_vb_obstacle_positions(config: &Path) -> Result<VbObstaclePositions> 
 }
 
 fn read_config(path: &Path) -> Result<VbConfig> {
-    let text = std::fs::read_to_string(path).map_err(|e| WorldError::io(path, e))?;
+    let text = crate::yaml::read_yaml_bounded(
+        path,
+        &crate::yaml::YamlLimits::DEFAULT,
+        "a Verti-Bench config",
+    )?;
     serde_norway::from_str(&text).map_err(|e| WorldError::invalid(path, "yaml", e.to_string()))
 }
 

@@ -10,6 +10,7 @@ pub mod format;
 pub mod generate;
 pub mod heightfield;
 pub mod import_vb;
+pub mod input;
 pub mod npy;
 pub mod obstacle;
 pub mod paths;

@@ -208,7 +208,14 @@ impl Obstacle {
 
 /// Vertices of the polytope `{p : n_i·p <= d_i}` (all triple-plane intersections that satisfy
 /// every constraint), deduplicated.
+///
+/// The tolerances are 1e-7 m (inside) and 1e-6 m (same vertex) for polytopes of a metre or
+/// more, and shrink with the polytope below that: fixed tolerances merged every vertex of a
+/// rock at scale 1e-8 into one, and generation panicked on the "rock" that was left.
 pub fn polytope_vertices(faces: &[Face]) -> Vec<Vec3> {
+    let size = faces.iter().map(|f| f.offset.abs()).fold(0.0, f64::max);
+    let unit = size.min(1.0);
+    let (inside_tol, same_tol) = (1e-7 * unit, 1e-6 * unit);
     let mut out: Vec<Vec3> = Vec::new();
     let n = faces.len();
     for i in 0..n {
@@ -223,8 +230,10 @@ pub fn polytope_vertices(faces: &[Face]) -> Vec<Vec3> {
                     + c.cross(a) * faces[j].offset
                     + a.cross(b) * faces[k].offset)
                     / det;
-                if faces.iter().all(|f| f.normal.dot(p) <= f.offset + 1e-7)
-                    && !out.iter().any(|q| (*q - p).norm() < 1e-6)
+                if faces
+                    .iter()
+                    .all(|f| f.normal.dot(p) <= f.offset + inside_tol)
+                    && !out.iter().any(|q| (*q - p).norm() < same_tol)
                 {
                     out.push(p);
                 }
@@ -364,6 +373,21 @@ mod tests {
         let (d, n) = tree.signed_distance(Vec3::new(0.0, 0.0, 5.2));
         assert!((d - 0.2).abs() < 1e-12 && (n - Vec3::Z).norm() < 1e-12);
         assert!(Obstacle::tree(-1.0, 5.0, Vec3::ZERO).is_err());
+    }
+
+    #[test]
+    fn tiny_rocks_keep_their_vertices() {
+        for size in [1e-3, 1e-8, 1e-20] {
+            let rock = Obstacle::rock(
+                box_faces(Vec3::new(4.0, 2.0, 3.0) * size),
+                1.0,
+                Vec3::ZERO,
+                0.3,
+            )
+            .unwrap();
+            assert_eq!(rock.vertices().len(), 8, "size {size}");
+            assert_eq!(rock.footprint().len(), 4, "size {size}");
+        }
     }
 
     #[test]
