@@ -12,6 +12,7 @@
 //! A world set is a directory of world directories plus `set.yaml` (name and member list).
 //! Loading validates everything and reports the file, the field and the problem.
 
+use crate::checks;
 use crate::error::{Result, WorldError};
 use crate::heightfield::Heightfield;
 use crate::npy;
@@ -248,15 +249,14 @@ fn finite(path: &Path, field: &str, v: f64) -> Result<f64> {
 
 /// Loads and validates a world directory (or a path to its `world.yaml`).
 pub fn load_world(path: &Path) -> Result<World> {
-    let dir: PathBuf = if path.is_dir() {
-        path.to_path_buf()
+    let (dir, mpath): (PathBuf, PathBuf) = if path.is_dir() {
+        (path.to_path_buf(), path.join(MANIFEST))
     } else {
-        path.parent().map(Path::to_path_buf).unwrap_or_default()
-    };
-    let mpath = if path.is_dir() {
-        dir.join(MANIFEST)
-    } else {
-        path.to_path_buf()
+        // a file, or a path that cannot be read: the reader says which (missing, a link loop...)
+        (
+            path.parent().map(Path::to_path_buf).unwrap_or_default(),
+            path.to_path_buf(),
+        )
     };
     let text = read_yaml_bounded(&mpath, &YamlLimits::DEFAULT, "the world manifest")?;
     let m: Manifest = serde_norway::from_str(&text).map_err(|e| {
@@ -311,18 +311,11 @@ pub fn load_world(path: &Path) -> Result<World> {
             "must be positive",
         ));
     }
+    checks::check_level(&mpath, m.level, max_height, m.scale)?;
     let n = m.grid.size;
-    if !(2..=4097).contains(&n) || !(n - 1).is_multiple_of(PATCHES_PER_SIDE) {
-        return Err(WorldError::invalid(
-            &mpath,
-            "grid.size",
-            format!("{n} is not 16k+1 vertices in 17..=4097"),
-        ));
-    }
+    checks::check_grid_size(&mpath, n)?;
     let cell = finite(&mpath, "grid.cell", m.grid.cell)?;
-    if cell <= 0.0 {
-        return Err(WorldError::invalid(&mpath, "grid.cell", "must be positive"));
-    }
+    checks::check_cell(&mpath, cell, m.scale)?;
 
     // elevation
     let epath = dir.join(&m.grid.elevation);
@@ -337,18 +330,13 @@ pub fn load_world(path: &Path) -> Result<World> {
             ),
         ));
     }
-    if let Some(i) = elev.data.iter().position(|v| !v.is_finite()) {
-        return Err(WorldError::invalid(
-            &epath,
-            "data",
-            format!(
-                "height at row {}, column {} is {}",
-                i / n,
-                i % n,
-                elev.data[i]
-            ),
-        ));
-    }
+    checks::check_heights(&epath, &elev.data, n, max_height)?;
+    let ground = elev
+        .data
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &h| {
+            (lo.min(h), hi.max(h))
+        });
 
     // patches
     if m.patches.len() != PATCHES_PER_SIDE * PATCHES_PER_SIDE {
@@ -477,6 +465,7 @@ pub fn load_world(path: &Path) -> Result<World> {
     }
 
     // obstacles
+    let half = 0.5 * (n - 1) as f64 * cell;
     let mut obstacles = Vec::with_capacity(m.obstacles.len());
     for (k, o) in m.obstacles.iter().enumerate() {
         let built = match o {
@@ -510,12 +499,12 @@ pub fn load_world(path: &Path) -> Result<World> {
                 Vec3::new(position[0], position[1], position[2]),
             ),
         };
-        obstacles
-            .push(built.map_err(|e| WorldError::invalid(&mpath, format!("obstacles[{k}]"), e))?);
+        let built = built.map_err(|e| WorldError::invalid(&mpath, format!("obstacles[{k}]"), e))?;
+        checks::check_obstacle(&mpath, k, &built, half, ground)?;
+        obstacles.push(built);
     }
 
     // tasks and paths
-    let half = 0.5 * (n - 1) as f64 * cell;
     for (k, t) in m.tasks.iter().enumerate() {
         for (what, p) in [("start", t.start), ("goal", t.goal)] {
             if !(p[0].is_finite() && p[1].is_finite() && p[0].abs() <= half && p[1].abs() <= half) {
@@ -545,7 +534,8 @@ pub fn load_world(path: &Path) -> Result<World> {
             ),
         ));
     }
-    let clearance = finite(&mpath, "paths.clearance", m.paths.clearance)?;
+    let clearance = m.paths.clearance;
+    checks::check_clearance(&mpath, clearance, m.scale)?;
     let mut paths = Vec::with_capacity(m.tasks.len());
     for (k, (p, t)) in m.paths.paths.iter().zip(&m.tasks).enumerate() {
         if p.pair != t.pair {
@@ -558,16 +548,7 @@ pub fn load_world(path: &Path) -> Result<World> {
                 ),
             ));
         }
-        if p.points
-            .iter()
-            .any(|q| !(q[0].is_finite() && q[1].is_finite()))
-        {
-            return Err(WorldError::invalid(
-                &mpath,
-                format!("paths.paths[{k}].points"),
-                "contains a non-finite point",
-            ));
-        }
+        checks::check_path_points(&mpath, k, &p.points, half)?;
         paths.push(GlobalPath {
             points: p.points.clone(),
         });
