@@ -117,7 +117,7 @@ pub fn check_obstacle(
             ),
         ));
     }
-    if o.radius_xy() > half_extent {
+    if !o.radius_xy().is_finite() || o.radius_xy() > half_extent {
         return Err(WorldError::invalid(
             mpath,
             field,
@@ -126,7 +126,7 @@ pub fn check_obstacle(
     }
     let (z0, z1) = o.z_range();
     let slack = REL_TOL * (1.0 + ground.1.abs());
-    if z0 > ground.1 + slack || z1 < ground.0 - slack {
+    if !(z0.is_finite() && z1.is_finite()) || z0 > ground.1 + slack || z1 < ground.0 - slack {
         return Err(WorldError::invalid(
             mpath,
             field,

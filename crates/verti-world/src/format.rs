@@ -19,7 +19,8 @@ use crate::npy;
 use crate::obstacle::{Face, Obstacle, ObstacleShape};
 use crate::surface::{PATCHES_PER_SIDE, Patch, PatchGrid, SoilParams, Surface, TerrainClass};
 use crate::world::{
-    ElevationLevel, GlobalPath, ObstacleDensity, Task, TerrainType, World, WorldMeta, WorldSource,
+    ElevationLevel, GlobalPath, ObstacleDensity, PAIRS_PER_WORLD, Task, TerrainType, World,
+    WorldMeta, WorldSource,
 };
 use crate::yaml::{YamlLimits, read_yaml_bounded};
 use serde::{Deserialize, Serialize};
@@ -33,6 +34,9 @@ pub const MANIFEST: &str = "world.yaml";
 pub const ELEVATION: &str = "elevation.npy";
 pub const LABELS: &str = "labels.npy";
 pub const SET_MANIFEST: &str = "set.yaml";
+/// Most obstacles a world may have: generated and imported worlds have at most 43, and each
+/// rock costs the loader up to a few hundred thousand operations.
+pub const MAX_OBSTACLES: usize = 1000;
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -267,15 +271,14 @@ pub fn load_world(path: &Path) -> Result<World> {
             .unwrap_or("manifest")
             .trim()
             .to_string();
-        WorldError::invalid(
-            &mpath,
-            if field.len() < 60 {
-                field
-            } else {
-                "manifest".into()
-            },
-            msg,
-        )
+        // serde names the field first (`patches[3].friction: ...`); other messages
+        // (a syntax error) have no field, and their first words are not one
+        let is_path = !field.is_empty()
+            && field.len() < 60
+            && field
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "_.[]".contains(c));
+        WorldError::invalid(&mpath, if is_path { field } else { "manifest".into() }, msg)
     })?;
     if m.format != FORMAT_NAME {
         return Err(WorldError::invalid(
@@ -466,6 +469,16 @@ pub fn load_world(path: &Path) -> Result<World> {
 
     // obstacles
     let half = 0.5 * (n - 1) as f64 * cell;
+    if m.obstacles.len() > MAX_OBSTACLES {
+        return Err(WorldError::invalid(
+            &mpath,
+            "obstacles",
+            format!(
+                "{} obstacles; a world may have at most {MAX_OBSTACLES} (dense worlds have 43)",
+                m.obstacles.len()
+            ),
+        ));
+    }
     let mut obstacles = Vec::with_capacity(m.obstacles.len());
     for (k, o) in m.obstacles.iter().enumerate() {
         let built = match o {
@@ -505,6 +518,7 @@ pub fn load_world(path: &Path) -> Result<World> {
     }
 
     // tasks and paths
+    let mut seen_pairs = std::collections::BTreeSet::new();
     for (k, t) in m.tasks.iter().enumerate() {
         for (what, p) in [("start", t.start), ("goal", t.goal)] {
             if !(p[0].is_finite() && p[1].is_finite() && p[0].abs() <= half && p[1].abs() <= half) {
@@ -515,7 +529,20 @@ pub fn load_world(path: &Path) -> Result<World> {
                 ));
             }
         }
-        if m.tasks[..k].iter().any(|u| u.pair == t.pair) {
+        // task numbers are (world - 1) * 10 + pair + 1: a pair of 10 or more would take
+        // another world's number
+        if t.pair >= PAIRS_PER_WORLD {
+            return Err(WorldError::invalid(
+                &mpath,
+                format!("tasks[{k}].pair"),
+                format!(
+                    "{} is not a pair number 0..={}",
+                    t.pair,
+                    PAIRS_PER_WORLD - 1
+                ),
+            ));
+        }
+        if !seen_pairs.insert(t.pair) {
             return Err(WorldError::invalid(
                 &mpath,
                 format!("tasks[{k}].pair"),

@@ -23,7 +23,8 @@ use crate::surface::{
     PATCHES_PER_SIDE, Patch, PatchGrid, RIGID_RESTITUTION, Surface, TerrainClass,
 };
 use crate::world::{
-    ElevationLevel, ObstacleDensity, Task, TerrainType, World, WorldMeta, WorldSource,
+    ElevationLevel, ObstacleDensity, PAIRS_PER_WORLD, Task, TerrainType, World, WorldMeta,
+    WorldSource,
 };
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -537,6 +538,16 @@ pub fn import_vb(
             start: get(&pair.start, "start")?,
             goal: get(&pair.goal, "goal")?,
         });
+    }
+    if tasks.len() > PAIRS_PER_WORLD as usize {
+        return Err(WorldError::invalid(
+            config,
+            "positions",
+            format!(
+                "{} start/goal pairs; a world has at most {PAIRS_PER_WORLD} (task numbers are (world - 1) * 10 + pair + 1)",
+                tasks.len()
+            ),
+        ));
     }
     if tasks.is_empty() {
         return Err(WorldError::invalid(

@@ -43,6 +43,11 @@ pub struct Obstacle {
     z_max: f64,
 }
 
+/// Most faces a rock may have. Generated rocks have 17 and imported boxes 6; finding the
+/// vertices costs the cube of the face count times the face count, so a file with thousands
+/// of faces per rock would hang the loader.
+pub const MAX_ROCK_FACES: usize = 32;
+
 impl Obstacle {
     /// Builds a rock. Fails when the faces do not bound a non-empty solid.
     pub fn rock(
@@ -51,9 +56,9 @@ impl Obstacle {
         position: Vec3,
         yaw: f64,
     ) -> Result<Obstacle, String> {
-        if faces.len() < 4 {
+        if !(4..=MAX_ROCK_FACES).contains(&faces.len()) {
             return Err(format!(
-                "a rock needs at least 4 faces, got {}",
+                "a rock needs 4 to {MAX_ROCK_FACES} faces, got {}",
                 faces.len()
             ));
         }
@@ -73,6 +78,10 @@ impl Obstacle {
         let local = polytope_vertices(&faces);
         if local.len() < 4 {
             return Err("the faces do not enclose a solid (fewer than 4 vertices)".into());
+        }
+        // finite faces can still meet at infinity (offsets near f64::MAX)
+        if local.iter().any(|v| !v.is_finite()) {
+            return Err("the faces meet at points too far away to represent".into());
         }
         let rotation = Quat::from_axis_angle(Vec3::Z, yaw);
         let vertices: Vec<Vec3> = local
