@@ -330,7 +330,9 @@ impl VehicleSpec {
         if self.name.trim().is_empty() {
             return Err(bad("name".into(), "must not be empty".into()));
         }
-        pos("scale", self.scale)?;
+        // the same range as world scales: a vehicle drives a world of its own scale
+        verti_world::scale::check_scale(self.scale)
+            .map_err(|e| bad("scale".into(), e.to_string()))?;
         pos("internal_step", self.internal_step)?;
         if !(1e-5..=0.01).contains(&self.internal_step) {
             return Err(bad(

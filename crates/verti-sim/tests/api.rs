@@ -111,6 +111,17 @@ fn nested_or_huge_vehicle_yaml_is_refused_before_parsing() {
         msg.contains("big.yaml") && msg.contains("16.0 MiB"),
         "{msg}"
     );
+    // a vehicle scale outside the world range is refused like a world scale
+    let text = vehicles::builtin_yaml("hmmwv")
+        .unwrap()
+        .replace("scale: 1.0", "scale: 1.0e-8");
+    let msg = VehicleSpec::from_yaml_str(&text, "tiny")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("`scale`") && msg.contains("[1/1000, 10]"),
+        "{msg}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
