@@ -105,10 +105,10 @@ fn nested_or_huge_vehicle_yaml_is_refused_before_parsing() {
     // a file over the cap is refused without being read
     let big = dir.join("big.yaml");
     let f = std::fs::File::create(&big).unwrap();
-    f.set_len(17 << 20).unwrap();
+    f.set_len(5 << 20).unwrap();
     let msg = VehicleSpec::from_file(&big).unwrap_err().to_string();
     assert!(
-        msg.contains("big.yaml") && msg.contains("16.0 MiB"),
+        msg.contains("big.yaml") && msg.contains("at most 4.0 MiB"),
         "{msg}"
     );
     // a vehicle scale outside the world range is refused like a world scale

@@ -67,7 +67,7 @@ fn nested_and_oversized_manifests_are_refused_quickly() {
         f.set_len(50 << 20).unwrap();
     });
     assert!(
-        e.contains("world.yaml") && e.contains("50.0 MiB") && e.contains("at most 16.0 MiB"),
+        e.contains("world.yaml") && e.contains("50.0 MiB") && e.contains("at most 4.0 MiB"),
         "{e}"
     );
     let e = load_error("binary", &w, &|d, _| {
