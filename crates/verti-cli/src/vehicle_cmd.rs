@@ -64,9 +64,14 @@ pub fn run_vehicle(cmd: VehicleCommand) -> CmdResult {
             if yaml {
                 match vehicles::builtin_yaml(&name) {
                     Some(t) => print!("{t}"),
+                    // the same size cap and path errors as loading it
                     None => print!(
                         "{}",
-                        std::fs::read_to_string(&name).map_err(|e| format!("{name}: {e}"))?
+                        verti_world::yaml::read_yaml_bounded(
+                            std::path::Path::new(&name),
+                            &verti_world::yaml::YamlLimits::DEFAULT,
+                            "a vehicle file",
+                        )?
                     ),
                 }
                 return Ok(());

@@ -67,7 +67,7 @@ pub struct StatsArgs {
 
 #[derive(Args)]
 pub struct ScaleArg {
-    /// World scale: 1, 1/6, 1/10 or any decimal in (0, 10]. Every length is multiplied by it.
+    /// World scale: 1, 1/6, 1/10 or any decimal in [1/1000, 10]. Every length is multiplied by it.
     /// Default 1 for generated and imported worlds; saved worlds keep the scale they were saved
     /// at, and asking for another is an error.
     #[arg(long, value_parser = scale_parser)]
@@ -293,13 +293,22 @@ fn import(a: ImportArgs) -> CmdResult {
     Ok(())
 }
 
+/// Tells the user when a built-in set name is used although something of that name is here.
+fn note_shadowed(spec: &str) {
+    if let Some(note) = verti_world::sets::builtin_shadow_note(spec) {
+        eprintln!("note: {note}");
+    }
+}
+
 fn show(a: ShowArgs) -> CmdResult {
+    note_shadowed(&a.world);
     let w = resolve_world_checked(&a.world, &a.scale)?;
     print!("{}", describe(&w));
     Ok(())
 }
 
 fn render(a: RenderArgs) -> CmdResult {
+    note_shadowed(&a.world);
     let w = resolve_world_checked(&a.world, &a.scale)?;
     let options = verti_render::RenderOptions {
         pixels_per_cell: a.px_per_cell,
@@ -413,6 +422,7 @@ pub fn load_set_with_progress(
     spec: &str,
     scale: f64,
 ) -> Result<verti_world::sets::WorldSet, WorldError> {
+    note_shadowed(spec);
     let pb = bar(0, "loading");
     let set = resolve_set(spec, scale, &|| pb.inc(1));
     pb.finish_and_clear();

@@ -286,3 +286,49 @@ fn world_commands_work_end_to_end() {
     let listed = run_ok(&["vehicle", "list"]);
     assert!(listed.contains("hmmwv") && listed.contains("m113"));
 }
+
+#[test]
+fn tiny_scales_are_errors_and_empty_folders_do_not_hide_built_in_sets() {
+    // a scale below the range used to panic with a backtrace inside rock generation
+    for args in [
+        vec!["world", "generate", "--count", "1", "--scale", "1e-8"],
+        vec!["eval", "--worlds", "verti-1", "--scale", "1e-8"],
+        vec!["world", "show", "verti-1:1", "--scale", "1/100000"],
+    ] {
+        let e = run_err(&args);
+        assert!(
+            e.contains("scale") && e.contains("[1/1000, 10]") && !e.contains("panicked"),
+            "{args:?}: {e}"
+        );
+    }
+    // an empty ./verti-2 is not a set: the built-in verti-2 is used, with a note
+    let cwd = tmp("shadow");
+    std::fs::create_dir_all(cwd.join("verti-2")).unwrap();
+    let out = verti()
+        .args(["world", "stats", "verti-2", "--json"])
+        .current_dir(&cwd)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("note:")
+            && err.contains("built-in set `verti-2`")
+            && err.contains("./verti-2"),
+        "{err}"
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["worlds"], 2);
+    // ./verti-2 names the directory, which says what it lacks
+    let out = verti()
+        .args(["world", "stats", "./verti-2"])
+        .current_dir(&cwd)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("not a world set"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(cwd).ok();
+}

@@ -202,6 +202,15 @@ pub struct TrackSpec {
 impl VehicleSpec {
     /// Parses and validates a vehicle from YAML text. `origin` names the source in errors.
     pub fn from_yaml_str(text: &str, origin: &str) -> Result<VehicleSpec, SpecError> {
+        // text from any source (a file, Python) gets the size and nesting limits every verti
+        // YAML input has, before the parser sees it
+        verti_world::yaml::check_yaml_text(text, &verti_world::yaml::YamlLimits::DEFAULT).map_err(
+            |r| SpecError::Invalid {
+                origin: origin.to_string(),
+                field: r.field.to_string(),
+                problem: r.problem,
+            },
+        )?;
         let spec: VehicleSpec = serde_norway::from_str(text).map_err(|e| SpecError::Parse {
             origin: origin.to_string(),
             message: e.to_string(),
@@ -213,9 +222,26 @@ impl VehicleSpec {
     /// Reads a user vehicle file.
     pub fn from_file(path: impl AsRef<Path>) -> Result<VehicleSpec, SpecError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| SpecError::Io {
-            path: path.to_path_buf(),
-            source,
+        let text = verti_world::yaml::read_yaml_bounded(
+            path,
+            &verti_world::yaml::YamlLimits::DEFAULT,
+            "a vehicle file",
+        )
+        .map_err(|e| match e {
+            verti_world::WorldError::Io { path, source } => SpecError::Io { path, source },
+            verti_world::WorldError::Invalid {
+                path,
+                field,
+                problem,
+            } => SpecError::Invalid {
+                origin: path.display().to_string(),
+                field,
+                problem,
+            },
+            verti_world::WorldError::Argument(problem) => SpecError::Parse {
+                origin: path.display().to_string(),
+                message: problem,
+            },
         })?;
         let spec = Self::from_yaml_str(&text, &path.display().to_string())?;
         // results record vehicles by name: a different vehicle under a built-in's name would be
@@ -304,7 +330,9 @@ impl VehicleSpec {
         if self.name.trim().is_empty() {
             return Err(bad("name".into(), "must not be empty".into()));
         }
-        pos("scale", self.scale)?;
+        // the same range as world scales: a vehicle drives a world of its own scale
+        verti_world::scale::check_scale(self.scale)
+            .map_err(|e| bad("scale".into(), e.to_string()))?;
         pos("internal_step", self.internal_step)?;
         if !(1e-5..=0.01).contains(&self.internal_step) {
             return Err(bad(

@@ -81,6 +81,51 @@ fn bad_vehicle_files_name_the_file_and_the_field() {
 }
 
 #[test]
+fn nested_or_huge_vehicle_yaml_is_refused_before_parsing() {
+    let dir = std::env::temp_dir().join(format!("verti-sim-yaml-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("deep.yaml");
+    // 200 KB of nested lists: the parser took close to a minute on this
+    let deep = format!("name: {}{}\n", "[".repeat(100_000), "]".repeat(100_000));
+    std::fs::write(&path, &deep).unwrap();
+    let t0 = std::time::Instant::now();
+    let msg = VehicleSpec::from_file(&path).unwrap_err().to_string();
+    assert!(t0.elapsed().as_millis() < 500, "{:?}", t0.elapsed());
+    assert!(
+        msg.contains("deep.yaml") && msg.contains("nesting depth") && msg.contains("64"),
+        "{msg}"
+    );
+    let msg = VehicleSpec::from_yaml_str(&deep, "python text")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("python text") && msg.contains("nesting"),
+        "{msg}"
+    );
+    // a file over the cap is refused without being read
+    let big = dir.join("big.yaml");
+    let f = std::fs::File::create(&big).unwrap();
+    f.set_len(5 << 20).unwrap();
+    let msg = VehicleSpec::from_file(&big).unwrap_err().to_string();
+    assert!(
+        msg.contains("big.yaml") && msg.contains("at most 4.0 MiB"),
+        "{msg}"
+    );
+    // a vehicle scale outside the world range is refused like a world scale
+    let text = vehicles::builtin_yaml("hmmwv")
+        .unwrap()
+        .replace("scale: 1.0", "scale: 1.0e-8");
+    let msg = VehicleSpec::from_yaml_str(&text, "tiny")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("`scale`") && msg.contains("[1/1000, 10]"),
+        "{msg}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
 fn bad_inputs_are_errors_not_panics() {
     let world = Arc::new(testing::flat_world(1.0, 0.8));
     let spec = vehicles::builtin("hmmwv").unwrap();

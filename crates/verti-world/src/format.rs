@@ -12,14 +12,17 @@
 //! A world set is a directory of world directories plus `set.yaml` (name and member list).
 //! Loading validates everything and reports the file, the field and the problem.
 
+use crate::checks;
 use crate::error::{Result, WorldError};
 use crate::heightfield::Heightfield;
 use crate::npy;
 use crate::obstacle::{Face, Obstacle, ObstacleShape};
 use crate::surface::{PATCHES_PER_SIDE, Patch, PatchGrid, SoilParams, Surface, TerrainClass};
 use crate::world::{
-    ElevationLevel, GlobalPath, ObstacleDensity, Task, TerrainType, World, WorldMeta, WorldSource,
+    ElevationLevel, GlobalPath, ObstacleDensity, PAIRS_PER_WORLD, Task, TerrainType, World,
+    WorldMeta, WorldSource,
 };
+use crate::yaml::{YamlLimits, read_yaml_bounded};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -31,6 +34,9 @@ pub const MANIFEST: &str = "world.yaml";
 pub const ELEVATION: &str = "elevation.npy";
 pub const LABELS: &str = "labels.npy";
 pub const SET_MANIFEST: &str = "set.yaml";
+/// Most obstacles a world may have: generated and imported worlds have at most 43, and each
+/// rock costs the loader up to a few hundred thousand operations.
+pub const MAX_OBSTACLES: usize = 1000;
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -247,17 +253,16 @@ fn finite(path: &Path, field: &str, v: f64) -> Result<f64> {
 
 /// Loads and validates a world directory (or a path to its `world.yaml`).
 pub fn load_world(path: &Path) -> Result<World> {
-    let dir: PathBuf = if path.is_dir() {
-        path.to_path_buf()
+    let (dir, mpath): (PathBuf, PathBuf) = if path.is_dir() {
+        (path.to_path_buf(), path.join(MANIFEST))
     } else {
-        path.parent().map(Path::to_path_buf).unwrap_or_default()
+        // a file, or a path that cannot be read: the reader says which (missing, a link loop...)
+        (
+            path.parent().map(Path::to_path_buf).unwrap_or_default(),
+            path.to_path_buf(),
+        )
     };
-    let mpath = if path.is_dir() {
-        dir.join(MANIFEST)
-    } else {
-        path.to_path_buf()
-    };
-    let text = std::fs::read_to_string(&mpath).map_err(|e| WorldError::io(&mpath, e))?;
+    let text = read_yaml_bounded(&mpath, &YamlLimits::DEFAULT, "the world manifest")?;
     let m: Manifest = serde_norway::from_str(&text).map_err(|e| {
         let msg = e.to_string();
         let field = msg
@@ -266,15 +271,14 @@ pub fn load_world(path: &Path) -> Result<World> {
             .unwrap_or("manifest")
             .trim()
             .to_string();
-        WorldError::invalid(
-            &mpath,
-            if field.len() < 60 {
-                field
-            } else {
-                "manifest".into()
-            },
-            msg,
-        )
+        // serde names the field first (`patches[3].friction: ...`); other messages
+        // (a syntax error) have no field, and their first words are not one
+        let is_path = !field.is_empty()
+            && field.len() < 60
+            && field
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "_.[]".contains(c));
+        WorldError::invalid(&mpath, if is_path { field } else { "manifest".into() }, msg)
     })?;
     if m.format != FORMAT_NAME {
         return Err(WorldError::invalid(
@@ -310,18 +314,11 @@ pub fn load_world(path: &Path) -> Result<World> {
             "must be positive",
         ));
     }
+    checks::check_level(&mpath, m.level, max_height, m.scale)?;
     let n = m.grid.size;
-    if !(2..=4097).contains(&n) || !(n - 1).is_multiple_of(PATCHES_PER_SIDE) {
-        return Err(WorldError::invalid(
-            &mpath,
-            "grid.size",
-            format!("{n} is not 16k+1 vertices in 17..=4097"),
-        ));
-    }
+    checks::check_grid_size(&mpath, n)?;
     let cell = finite(&mpath, "grid.cell", m.grid.cell)?;
-    if cell <= 0.0 {
-        return Err(WorldError::invalid(&mpath, "grid.cell", "must be positive"));
-    }
+    checks::check_cell(&mpath, cell, m.scale)?;
 
     // elevation
     let epath = dir.join(&m.grid.elevation);
@@ -336,18 +333,13 @@ pub fn load_world(path: &Path) -> Result<World> {
             ),
         ));
     }
-    if let Some(i) = elev.data.iter().position(|v| !v.is_finite()) {
-        return Err(WorldError::invalid(
-            &epath,
-            "data",
-            format!(
-                "height at row {}, column {} is {}",
-                i / n,
-                i % n,
-                elev.data[i]
-            ),
-        ));
-    }
+    checks::check_heights(&epath, &elev.data, n, max_height)?;
+    let ground = elev
+        .data
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &h| {
+            (lo.min(h), hi.max(h))
+        });
 
     // patches
     if m.patches.len() != PATCHES_PER_SIDE * PATCHES_PER_SIDE {
@@ -476,6 +468,17 @@ pub fn load_world(path: &Path) -> Result<World> {
     }
 
     // obstacles
+    let half = 0.5 * (n - 1) as f64 * cell;
+    if m.obstacles.len() > MAX_OBSTACLES {
+        return Err(WorldError::invalid(
+            &mpath,
+            "obstacles",
+            format!(
+                "{} obstacles; a world may have at most {MAX_OBSTACLES} (dense worlds have 43)",
+                m.obstacles.len()
+            ),
+        ));
+    }
     let mut obstacles = Vec::with_capacity(m.obstacles.len());
     for (k, o) in m.obstacles.iter().enumerate() {
         let built = match o {
@@ -509,12 +512,13 @@ pub fn load_world(path: &Path) -> Result<World> {
                 Vec3::new(position[0], position[1], position[2]),
             ),
         };
-        obstacles
-            .push(built.map_err(|e| WorldError::invalid(&mpath, format!("obstacles[{k}]"), e))?);
+        let built = built.map_err(|e| WorldError::invalid(&mpath, format!("obstacles[{k}]"), e))?;
+        checks::check_obstacle(&mpath, k, &built, half, ground)?;
+        obstacles.push(built);
     }
 
     // tasks and paths
-    let half = 0.5 * (n - 1) as f64 * cell;
+    let mut seen_pairs = std::collections::BTreeSet::new();
     for (k, t) in m.tasks.iter().enumerate() {
         for (what, p) in [("start", t.start), ("goal", t.goal)] {
             if !(p[0].is_finite() && p[1].is_finite() && p[0].abs() <= half && p[1].abs() <= half) {
@@ -525,7 +529,20 @@ pub fn load_world(path: &Path) -> Result<World> {
                 ));
             }
         }
-        if m.tasks[..k].iter().any(|u| u.pair == t.pair) {
+        // task numbers are (world - 1) * 10 + pair + 1: a pair of 10 or more would take
+        // another world's number
+        if t.pair >= PAIRS_PER_WORLD {
+            return Err(WorldError::invalid(
+                &mpath,
+                format!("tasks[{k}].pair"),
+                format!(
+                    "{} is not a pair number 0..={}",
+                    t.pair,
+                    PAIRS_PER_WORLD - 1
+                ),
+            ));
+        }
+        if !seen_pairs.insert(t.pair) {
             return Err(WorldError::invalid(
                 &mpath,
                 format!("tasks[{k}].pair"),
@@ -544,7 +561,8 @@ pub fn load_world(path: &Path) -> Result<World> {
             ),
         ));
     }
-    let clearance = finite(&mpath, "paths.clearance", m.paths.clearance)?;
+    let clearance = m.paths.clearance;
+    checks::check_clearance(&mpath, clearance, m.scale)?;
     let mut paths = Vec::with_capacity(m.tasks.len());
     for (k, (p, t)) in m.paths.paths.iter().zip(&m.tasks).enumerate() {
         if p.pair != t.pair {
@@ -557,16 +575,7 @@ pub fn load_world(path: &Path) -> Result<World> {
                 ),
             ));
         }
-        if p.points
-            .iter()
-            .any(|q| !(q[0].is_finite() && q[1].is_finite()))
-        {
-            return Err(WorldError::invalid(
-                &mpath,
-                format!("paths.paths[{k}].points"),
-                "contains a non-finite point",
-            ));
-        }
+        checks::check_path_points(&mpath, k, &p.points, half)?;
         paths.push(GlobalPath {
             points: p.points.clone(),
         });
@@ -647,7 +656,7 @@ pub fn save_set(
 /// Reads a set manifest.
 pub fn read_set_manifest(dir: &Path) -> Result<SetManifest> {
     let p = dir.join(SET_MANIFEST);
-    let text = std::fs::read_to_string(&p).map_err(|e| WorldError::io(&p, e))?;
+    let text = read_yaml_bounded(&p, &YamlLimits::DEFAULT, "the set manifest")?;
     let m: SetManifest = serde_norway::from_str(&text)
         .map_err(|e| WorldError::invalid(&p, "manifest", e.to_string()))?;
     if m.format != "verti-world-set" {

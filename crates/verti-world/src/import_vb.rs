@@ -23,7 +23,8 @@ use crate::surface::{
     PATCHES_PER_SIDE, Patch, PatchGrid, RIGID_RESTITUTION, Surface, TerrainClass,
 };
 use crate::world::{
-    ElevationLevel, ObstacleDensity, Task, TerrainType, World, WorldMeta, WorldSource,
+    ElevationLevel, ObstacleDensity, PAIRS_PER_WORLD, Task, TerrainType, World, WorldMeta,
+    WorldSource,
 };
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -138,13 +139,75 @@ pub fn read_vb_obstacle_positions(config: &Path) -> Result<VbObstaclePositions> 
 }
 
 fn read_config(path: &Path) -> Result<VbConfig> {
-    let text = std::fs::read_to_string(path).map_err(|e| WorldError::io(path, e))?;
+    let text = crate::yaml::read_yaml_bounded(
+        path,
+        &crate::yaml::YamlLimits::DEFAULT,
+        "a Verti-Bench config",
+    )?;
     serde_norway::from_str(&text).map_err(|e| WorldError::invalid(path, "yaml", e.to_string()))
+}
+
+/// Largest heightmap read: a 129 x 129 BMP is 18 KiB even at 32 bits per pixel.
+const MAX_BMP_BYTES: u64 = 1 << 20;
+
+/// Checks what a BMP header says before the image is decoded: a size of at most 4097 pixels
+/// per side, and a pixel format that holds 8-bit grey levels exactly. 16-bit BMPs (5 or 6 bits
+/// per channel) do not: the decoder stretched them to 8 bits, so grey levels came out up to
+/// 6 steps off (0.38 m at 16 m) without a word; so do bit-field masks wider or narrower than 8
+/// bits.
+fn check_bmp_header(path: &Path, b: &[u8]) -> Result<()> {
+    let u16_at = |i: usize| b.get(i..i + 2).map(|s| u16::from_le_bytes([s[0], s[1]]));
+    let u32_at = |i: usize| {
+        b.get(i..i + 4)
+            .map(|s| u32::from_le_bytes([s[0], s[1], s[2], s[3]]))
+    };
+    let bad = |p: String| WorldError::invalid(path, "bmp", format!("not a usable BMP: {p}"));
+    if !b.starts_with(b"BM") {
+        return Err(bad("not a BMP file (no `BM` signature)".into()));
+    }
+    let header = u32_at(14).ok_or_else(|| bad("truncated header".into()))?;
+    let (w, h, bpp, compression) = if header == 12 {
+        let w = u16_at(18).unwrap_or(0);
+        let h = u16_at(20).unwrap_or(0);
+        (i64::from(w), i64::from(h), u16_at(24), Some(0))
+    } else {
+        let w = u32_at(18).map_or(0, |v| i64::from(v as i32));
+        let h = u32_at(22).map_or(0, |v| i64::from(v as i32));
+        (w, h, u16_at(28), u32_at(30))
+    };
+    let (Some(bpp), Some(compression)) = (bpp, compression) else {
+        return Err(bad("truncated header".into()));
+    };
+    if !(1..=4097).contains(&w) || !(1..=4097).contains(&h.abs()) {
+        return Err(bad(format!(
+            "header says {w}x{} pixels; a heightmap is at most 4097x4097",
+            h.abs()
+        )));
+    }
+    if bpp == 16 {
+        return Err(bad(
+            "16-bit BMP: 5-6 bits per channel cannot hold the 256 grey levels of a heightmap exactly (heights would be off by up to 6 grey steps); save it as an 8-bit grey or a 24-bit BMP".into(),
+        ));
+    }
+    // BI_BITFIELDS / BI_ALPHABITFIELDS: colour masks follow the 40-byte info header
+    if matches!(compression, 3 | 6) && bpp == 32 {
+        for (k, name) in ["red", "green", "blue"].iter().enumerate() {
+            let mask = u32_at(54 + 4 * k).unwrap_or(0);
+            if mask.count_ones() != 8 {
+                return Err(bad(format!(
+                    "32-bit BMP with a {}-bit {name} channel: only 8-bit channels hold grey levels exactly",
+                    mask.count_ones()
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Reads an 8-bit grey BMP (palettised or RGB with equal channels) into grey levels.
 pub fn read_grey_bmp(path: &Path) -> Result<(usize, usize, Vec<u8>)> {
-    let bytes = std::fs::read(path).map_err(|e| WorldError::io(path, e))?;
+    let bytes = crate::input::read_capped(path, MAX_BMP_BYTES, "a heightmap BMP")?;
+    check_bmp_header(path, &bytes)?;
     let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Bmp)
         .map_err(|e| WorldError::invalid(path, "bmp", format!("not a readable BMP: {e}")))?;
     let rgb = img.to_rgb8();
@@ -161,6 +224,54 @@ pub fn read_grey_bmp(path: &Path) -> Result<(usize, usize, Vec<u8>)> {
         grey.push(p[0]);
     }
     Ok((h, w, grey))
+}
+
+/// Checks every pixel of a Verti-Bench label grid against the patches. Pixel (r, c) holds the
+/// class of patch (min(r / 8, 15), min(c / 8, 15)) (the shared borders carry the later patch's
+/// label). The one known exception (spec §1.5): in mixed worlds, pixels of the map's last row
+/// or column may keep the deformable label a patch had before it was converted to rigid; they
+/// are accepted when they hold a deformable class. Every other disagreement, and any value that
+/// is not a class id, is refused with its position.
+fn check_vb_labels(
+    lpath: &Path,
+    data: &[f64],
+    patches: &PatchGrid,
+    terrain_type: TerrainType,
+    config: &Path,
+) -> Result<()> {
+    let last = VB_GRID - 1;
+    for (k, &v) in data.iter().enumerate() {
+        let (r, c) = (k / VB_GRID, k % VB_GRID);
+        let (i, j) = ((r / 8).min(15), (c / 8).min(15));
+        let class = patches.get(i, j).class;
+        if v == f64::from(class.id()) {
+            continue;
+        }
+        let label = (v.fract() == 0.0)
+            .then(|| TerrainClass::from_id(v as i64))
+            .flatten();
+        let Some(label) = label else {
+            return Err(WorldError::invalid(
+                lpath,
+                format!("label at row {r}, column {c}"),
+                format!("{v} is not a class id (0..=9)"),
+            ));
+        };
+        let edge_quirk =
+            terrain_type == TerrainType::Mixed && (r == last || c == last) && label.is_deformable();
+        if !edge_quirk {
+            return Err(WorldError::invalid(
+                lpath,
+                format!("label at row {r}, column {c}"),
+                format!(
+                    "{v} ({label}) disagrees with patch [{i}, {j}] = {class} ({}) in {}",
+                    class.id(),
+                    config.display()
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// World id from a Verti-Bench config name: `config12_high.yaml` → 12.
@@ -202,6 +313,19 @@ pub fn import_vb(
             format!("{} must be a positive number", cfg.terrain.max_height),
         ));
     }
+    // every Verti-Bench world's max_height is its difficulty's ceiling (4.8, 9.6 or 16 m)
+    crate::checks::check_level(config, level, cfg.terrain.max_height, 1.0).map_err(|_| {
+        WorldError::invalid(
+            config,
+            "terrain.max_height",
+            format!(
+                "{} m contradicts difficulty `{}`, whose worlds have max_height {} m",
+                cfg.terrain.max_height,
+                cfg.terrain.difficulty,
+                level.max_height()
+            ),
+        )
+    })?;
     if cfg.terrain.min_height != 0.0 {
         return Err(WorldError::invalid(
             config,
@@ -323,25 +447,7 @@ pub fn import_vb(
                 format!("expected (129, 129), found ({}, {})", arr.rows, arr.cols),
             ));
         }
-        // Interior pixels only: the shared patch borders carry the later patch's label, and
-        // a few borders of mixed worlds keep pre-conversion labels (spec §1.5).
-        for i in 0..PATCHES_PER_SIDE {
-            for j in 0..PATCHES_PER_SIDE {
-                let v = arr.data[(8 * i + 4) * VB_GRID + 8 * j + 4];
-                let class = patches.get(i, j).class;
-                if v != f64::from(class.id()) {
-                    return Err(WorldError::invalid(
-                        lpath,
-                        format!("label at row {}, column {}", 8 * i + 4, 8 * j + 4),
-                        format!(
-                            "{v} disagrees with patch [{i}, {j}] = {class} ({}) in {}",
-                            class.id(),
-                            config.display()
-                        ),
-                    ));
-                }
-            }
-        }
+        check_vb_labels(lpath, &arr.data, &patches, terrain_type, config)?;
     }
 
     // obstacles: reference geometry, seated on the ground
@@ -432,6 +538,16 @@ pub fn import_vb(
             start: get(&pair.start, "start")?,
             goal: get(&pair.goal, "goal")?,
         });
+    }
+    if tasks.len() > PAIRS_PER_WORLD as usize {
+        return Err(WorldError::invalid(
+            config,
+            "positions",
+            format!(
+                "{} start/goal pairs; a world has at most {PAIRS_PER_WORLD} (task numbers are (world - 1) * 10 + pair + 1)",
+                tasks.len()
+            ),
+        ));
     }
     if tasks.is_empty() {
         return Err(WorldError::invalid(

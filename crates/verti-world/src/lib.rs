@@ -5,11 +5,13 @@
 //! [`GlobalPath`]s), the procedural generator of the 100-world / 1000-task benchmark set, the
 //! versioned on-disk format, and the importer for original Verti-Bench worlds.
 
+pub mod checks;
 pub mod error;
 pub mod format;
 pub mod generate;
 pub mod heightfield;
 pub mod import_vb;
+pub mod input;
 pub mod npy;
 pub mod obstacle;
 pub mod paths;

@@ -43,6 +43,11 @@ pub struct Obstacle {
     z_max: f64,
 }
 
+/// Most faces a rock may have. Generated rocks have 17 and imported boxes 6; finding the
+/// vertices costs the cube of the face count times the face count, so a file with thousands
+/// of faces per rock would hang the loader.
+pub const MAX_ROCK_FACES: usize = 32;
+
 impl Obstacle {
     /// Builds a rock. Fails when the faces do not bound a non-empty solid.
     pub fn rock(
@@ -51,9 +56,9 @@ impl Obstacle {
         position: Vec3,
         yaw: f64,
     ) -> Result<Obstacle, String> {
-        if faces.len() < 4 {
+        if !(4..=MAX_ROCK_FACES).contains(&faces.len()) {
             return Err(format!(
-                "a rock needs at least 4 faces, got {}",
+                "a rock needs 4 to {MAX_ROCK_FACES} faces, got {}",
                 faces.len()
             ));
         }
@@ -73,6 +78,10 @@ impl Obstacle {
         let local = polytope_vertices(&faces);
         if local.len() < 4 {
             return Err("the faces do not enclose a solid (fewer than 4 vertices)".into());
+        }
+        // finite faces can still meet at infinity (offsets near f64::MAX)
+        if local.iter().any(|v| !v.is_finite()) {
+            return Err("the faces meet at points too far away to represent".into());
         }
         let rotation = Quat::from_axis_angle(Vec3::Z, yaw);
         let vertices: Vec<Vec3> = local
@@ -208,7 +217,14 @@ impl Obstacle {
 
 /// Vertices of the polytope `{p : n_i·p <= d_i}` (all triple-plane intersections that satisfy
 /// every constraint), deduplicated.
+///
+/// The tolerances are 1e-7 m (inside) and 1e-6 m (same vertex) for polytopes of a metre or
+/// more, and shrink with the polytope below that: fixed tolerances merged every vertex of a
+/// rock at scale 1e-8 into one, and generation panicked on the "rock" that was left.
 pub fn polytope_vertices(faces: &[Face]) -> Vec<Vec3> {
+    let size = faces.iter().map(|f| f.offset.abs()).fold(0.0, f64::max);
+    let unit = size.min(1.0);
+    let (inside_tol, same_tol) = (1e-7 * unit, 1e-6 * unit);
     let mut out: Vec<Vec3> = Vec::new();
     let n = faces.len();
     for i in 0..n {
@@ -223,8 +239,10 @@ pub fn polytope_vertices(faces: &[Face]) -> Vec<Vec3> {
                     + c.cross(a) * faces[j].offset
                     + a.cross(b) * faces[k].offset)
                     / det;
-                if faces.iter().all(|f| f.normal.dot(p) <= f.offset + 1e-7)
-                    && !out.iter().any(|q| (*q - p).norm() < 1e-6)
+                if faces
+                    .iter()
+                    .all(|f| f.normal.dot(p) <= f.offset + inside_tol)
+                    && !out.iter().any(|q| (*q - p).norm() < same_tol)
                 {
                     out.push(p);
                 }
@@ -364,6 +382,21 @@ mod tests {
         let (d, n) = tree.signed_distance(Vec3::new(0.0, 0.0, 5.2));
         assert!((d - 0.2).abs() < 1e-12 && (n - Vec3::Z).norm() < 1e-12);
         assert!(Obstacle::tree(-1.0, 5.0, Vec3::ZERO).is_err());
+    }
+
+    #[test]
+    fn tiny_rocks_keep_their_vertices() {
+        for size in [1e-3, 1e-8, 1e-20] {
+            let rock = Obstacle::rock(
+                box_faces(Vec3::new(4.0, 2.0, 3.0) * size),
+                1.0,
+                Vec3::ZERO,
+                0.3,
+            )
+            .unwrap();
+            assert_eq!(rock.vertices().len(), 8, "size {size}");
+            assert_eq!(rock.footprint().len(), 4, "size {size}");
+        }
     }
 
     #[test]

@@ -4,7 +4,7 @@
 use crate::error::{Result, WorldError};
 
 /// Parses a scale written as a decimal (`0.1`, `1`) or a fraction (`1/6`, `1/10`).
-/// Accepted range: (0, 10].
+/// Accepted range: [1/1000, 10].
 pub fn parse_scale(text: &str) -> Result<f64> {
     let t = text.trim();
     let value = if let Some((num, den)) = t.split_once('/') {
@@ -33,11 +33,18 @@ pub fn parse_scale(text: &str) -> Result<f64> {
     Ok(value)
 }
 
-/// Rejects scales that are not finite or outside (0, 10].
+/// Smallest accepted scale: a 13 cm world, already 100 times smaller than the smallest vehicle
+/// verti ships (1/10). Far below it lengths reach the fixed tolerances of contact, soil and
+/// planning, and near 1e-300 they underflow f64 (a rock's faces square to zero).
+pub const MIN_SCALE: f64 = 1e-3;
+/// Largest accepted scale.
+pub const MAX_SCALE: f64 = 10.0;
+
+/// Rejects scales that are not finite or outside [1/1000, 10].
 pub fn check_scale(value: f64) -> Result<()> {
-    if !value.is_finite() || value <= 0.0 || value > 10.0 {
+    if !(value.is_finite() && (MIN_SCALE..=MAX_SCALE).contains(&value)) {
         return Err(WorldError::Argument(format!(
-            "scale {value} is out of range: it must be in (0, 10], e.g. 1, 1/6 or 1/10"
+            "scale {value} is out of range: it must be in [1/1000, 10], e.g. 1, 1/6 or 1/10"
         )));
     }
     Ok(())
@@ -110,13 +117,28 @@ mod tests {
         assert!((parse_scale("1/6").unwrap() - 1.0 / 6.0).abs() < 1e-15);
         assert_eq!(parse_scale(" 1/10 ").unwrap(), 0.1);
         assert_eq!(parse_scale("0.25").unwrap(), 0.25);
+        assert_eq!(parse_scale("1/1000").unwrap(), MIN_SCALE);
+        assert_eq!(parse_scale("10").unwrap(), MAX_SCALE);
         assert_eq!(scale_label(1.0 / 6.0), "1/6");
         assert_eq!(scale_label(0.1), "1/10");
     }
 
     #[test]
     fn rejects_bad_scales() {
-        for bad in ["0", "-1", "1/0", "abc", "nan", "inf", "20", "1/x"] {
+        for bad in [
+            "0",
+            "-1",
+            "1/0",
+            "abc",
+            "nan",
+            "inf",
+            "20",
+            "1/x",
+            "1e-8",
+            "1/10000",
+            "1e-300",
+            "10.000001",
+        ] {
             let e = parse_scale(bad).unwrap_err().to_string();
             assert!(e.contains("scale"), "{bad}: {e}");
         }

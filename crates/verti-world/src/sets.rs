@@ -11,7 +11,7 @@
 use crate::error::{Result, WorldError};
 use crate::format::{MANIFEST, SET_MANIFEST, load_set, load_world};
 use crate::generate::{SetConfig, generate_set, set_name};
-use crate::import_vb::{ImportOptions, import_vb, scan_vb_dir};
+use crate::import_vb::{ImportOptions, import_vb, index_from_config_name, scan_vb_dir};
 use crate::world::World;
 use rayon::prelude::*;
 use std::path::Path;
@@ -38,24 +38,68 @@ pub fn builtin_config(spec: &str, scale: f64) -> Option<SetConfig> {
     })
 }
 
+/// True when something (a file, a directory, a broken link) is at `path`.
+fn present(path: &Path) -> bool {
+    path.symlink_metadata().is_ok()
+}
+
+/// True when `dir` holds any `configN_LEVEL.yaml` (an original Verti-Bench folder).
+fn has_vb_configs(dir: &Path) -> bool {
+    std::fs::read_dir(dir).is_ok_and(|entries| {
+        entries.flatten().any(|e| {
+            let p = e.path();
+            p.extension().is_some_and(|x| x == "yaml") && index_from_config_name(&p).is_some()
+        })
+    })
+}
+
+/// True when `path` is something a set spec can name: a saved set, a world directory or a
+/// Verti-Bench folder (or a manifest that is there but unreadable, which should be reported).
+fn is_world_source(path: &Path) -> bool {
+    present(&path.join(SET_MANIFEST))
+        || present(&path.join(MANIFEST))
+        || (path.is_dir() && has_vb_configs(path))
+}
+
+/// When `spec` names a built-in set (`verti-100`) and something of that name in the current
+/// directory is not a world set (an empty folder, say), the built-in set is used; this is the
+/// note to show the user. Without it an empty `./verti-100` silently turned `verti-100` into
+/// an error about Verti-Bench configs.
+pub fn builtin_shadow_note(spec: &str) -> Option<String> {
+    let set = match spec.rsplit_once(':') {
+        Some((set, index)) if index.parse::<u32>().is_ok() => set,
+        _ => spec,
+    };
+    let path = Path::new(set);
+    (builtin_config(set, 1.0).is_some() && present(path) && !is_world_source(path)).then(|| {
+        format!(
+            "`{set}` here is not a world set (no set.yaml, world.yaml or Verti-Bench configs): using the built-in set `{set}`; to use the directory, make it a set or name it as ./{set}"
+        )
+    })
+}
+
 /// Resolves a set spec. `scale` applies to built-in and imported sets; saved sets carry theirs.
 pub fn resolve_set(spec: &str, scale: f64, progress: &(dyn Fn() + Sync)) -> Result<WorldSet> {
     let path = Path::new(spec);
-    if path.join(SET_MANIFEST).is_file() {
+    // a manifest that is there in any form is loaded, so a directory or a link loop in its
+    // place is reported as what it is
+    if present(&path.join(SET_MANIFEST)) {
         let (m, worlds) = load_set(path)?;
         return Ok(WorldSet {
             name: m.name,
             worlds,
         });
     }
-    if path.join(MANIFEST).is_file() {
+    if present(&path.join(MANIFEST))
+        || (path.is_file() && path.extension().is_some_and(|e| e == "yaml"))
+    {
         let w = load_world(path)?;
         return Ok(WorldSet {
             name: w.meta.name.clone(),
             worlds: vec![w],
         });
     }
-    if path.is_dir() {
+    if path.is_dir() && has_vb_configs(path) {
         let files = scan_vb_dir(path)?;
         let opts = ImportOptions {
             scale,
@@ -79,12 +123,25 @@ pub fn resolve_set(spec: &str, scale: f64, progress: &(dyn Fn() + Sync)) -> Resu
             worlds,
         });
     }
+    // a built-in name wins over a directory of that name that holds no set (see
+    // builtin_shadow_note); `./verti-100` always means the directory
     if let Some(config) = builtin_config(spec, scale) {
         let worlds = generate_set(&config, progress)?;
         return Ok(WorldSet {
             name: set_name(&config),
             worlds,
         });
+    }
+    if let Some(e) = crate::input::unreadable_reason(path, "a world set")
+        && present(path)
+        && e.kind() != std::io::ErrorKind::IsADirectory
+    {
+        return Err(WorldError::io(path, e));
+    }
+    if path.is_dir() {
+        return Err(WorldError::Argument(format!(
+            "{spec} is a directory but not a world set: it has no set.yaml (a saved set), no world.yaml (a world) and no configN_LEVEL.yaml (Verti-Bench worlds)"
+        )));
     }
     Err(WorldError::Argument(format!(
         "unknown world set `{spec}`: expected `verti-100` (built-in), a set directory (with set.yaml), a world directory (with world.yaml) or a folder of Verti-Bench configs"
@@ -94,21 +151,32 @@ pub fn resolve_set(spec: &str, scale: f64, progress: &(dyn Fn() + Sync)) -> Resu
 /// Resolves a single world: a world directory or `SET:INDEX` (1-based index).
 pub fn resolve_world(spec: &str, scale: f64) -> Result<World> {
     let path = Path::new(spec);
-    if path.join(MANIFEST).is_file()
+    if present(&path.join(MANIFEST))
         || (path.is_file() && path.extension().is_some_and(|e| e == "yaml"))
     {
         return load_world(path);
     }
-    let (set, index) = spec.rsplit_once(':').ok_or_else(|| {
-        WorldError::Argument(format!("`{spec}` is not a world directory; name a world of a set as SET:INDEX, e.g. verti-100:42"))
-    })?;
+    let Some((set, index)) = spec.rsplit_once(':') else {
+        if present(&path.join(SET_MANIFEST)) || (path.is_dir() && has_vb_configs(path)) {
+            return Err(WorldError::Argument(format!(
+                "{spec} is a world set, not a world: name one of its worlds as {spec}:INDEX"
+            )));
+        }
+        if present(path) {
+            // the loader says what is wrong: no world.yaml, a link loop, permission denied...
+            return load_world(path);
+        }
+        return Err(WorldError::Argument(format!(
+            "`{spec}` is not a world directory; name a world of a set as SET:INDEX, e.g. verti-100:42"
+        )));
+    };
     let index: u32 = index.parse().map_err(|_| {
         WorldError::Argument(format!(
             "`{index}` in `{spec}` is not a world index (1-based integer)"
         ))
     })?;
-    // Generate only the requested world of a built-in set.
-    if !Path::new(set).exists()
+    // Generate only the requested world of a built-in set (unless a set of that name is here).
+    if !is_world_source(Path::new(set))
         && let Some(config) = builtin_config(set, scale)
     {
         config.validate()?;

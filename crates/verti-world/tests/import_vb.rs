@@ -286,3 +286,74 @@ fn a_clearance_that_is_not_a_length_is_refused_before_anything_is_read() {
         assert!(e.contains("clearance") && e.contains("[0, 20]"), "{e}");
     }
 }
+
+#[test]
+fn every_imported_world_passes_the_loader_s_checks() {
+    let Some(dir) = vb_dir() else { return };
+    let files = scan_vb_dir(&dir).unwrap();
+    let worlds: Vec<_> = files
+        .iter()
+        .map(|f| {
+            import_vb(
+                &f.config,
+                &f.heightmap,
+                f.labels.as_deref(),
+                &ImportOptions::default(),
+            )
+            .unwrap()
+        })
+        .collect();
+    let out = std::env::temp_dir().join(format!("verti-vb-roundtrip-{}", std::process::id()));
+    verti_world::format::save_set(&worlds, "vb", None, &out, &|| {}).unwrap();
+    let (_, back) = verti_world::format::load_set(&out).unwrap();
+    assert_eq!(back.len(), 80);
+    std::fs::remove_dir_all(&out).ok();
+}
+
+#[test]
+fn labels_are_checked_at_every_pixel_and_levels_against_max_height() {
+    let Some(dir) = vb_dir() else { return };
+    let tmp = std::env::temp_dir().join(format!("verti-vb-labels-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let config = dir.join("config12_high.yaml");
+    let bmp = dir.join("world12.bmp");
+    let labels = npy::read_array2(&dir.join("labels12_high.npy")).unwrap();
+    let write = |data: &[f64]| {
+        let p = tmp.join("labels12_high.npy");
+        let ints: Vec<i32> = data.iter().map(|&v| v as i32).collect();
+        npy::write_i32(&p, VB_GRID, VB_GRID, &ints).unwrap();
+        p
+    };
+    // far from any patch centre (row 1, column 2): only centres were checked before
+    for (value, want) in [(42.0, "not a class id"), (9.0, "disagrees")] {
+        let mut data = labels.data.clone();
+        if data[VB_GRID + 2] == value {
+            continue;
+        }
+        data[VB_GRID + 2] = value;
+        let e = import_vb(
+            &config,
+            &bmp,
+            Some(&write(&data)),
+            &ImportOptions::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("labels12_high.npy") && e.contains("row 1, column 2") && e.contains(want),
+            "{e}"
+        );
+    }
+    // a difficulty that contradicts the terrain's ceiling
+    let text = std::fs::read_to_string(&config).unwrap();
+    let bad = tmp.join("config12_high.yaml");
+    std::fs::write(&bad, text.replace("max_height: 16.0", "max_height: 4.8")).unwrap();
+    let e = import_vb(&bad, &bmp, None, &ImportOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("config12_high.yaml") && e.contains("terrain.max_height") && e.contains("high"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&tmp).ok();
+}

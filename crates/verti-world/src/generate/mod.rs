@@ -185,6 +185,14 @@ pub fn generate_world(
     density: ObstacleDensity,
     source: &dyn ElevationSource,
 ) -> Result<World> {
+    // callers may come straight here (Python, benches): a bad scale must be an error, not a
+    // panic deep inside the heightfield or the obstacle geometry
+    config.validate()?;
+    if index == 0 {
+        return Err(WorldError::Argument(
+            "world indices start at 1, not 0".into(),
+        ));
+    }
     let scale = config.scale;
     let cell = scale;
     let max_height = level.max_height() * scale;
@@ -193,6 +201,27 @@ pub fn generate_world(
         &mut Rng::derive(seed, "elevation", u64::from(index)),
         GRID_SIZE,
     );
+    // elevation sources are pluggable: hold them to their contract (n x n fractions in [0, 1])
+    if fractions.len() != GRID_SIZE * GRID_SIZE {
+        return Err(WorldError::Argument(format!(
+            "elevation source `{}` returned {} heights, expected {}",
+            source.name(),
+            fractions.len(),
+            GRID_SIZE * GRID_SIZE
+        )));
+    }
+    if let Some(k) = fractions
+        .iter()
+        .position(|f| !(f.is_finite() && (0.0..=1.0).contains(f)))
+    {
+        return Err(WorldError::Argument(format!(
+            "elevation source `{}` returned height fraction {} at row {}, column {}: fractions must be in [0, 1]",
+            source.name(),
+            fractions[k],
+            k / GRID_SIZE,
+            k % GRID_SIZE
+        )));
+    }
     // Heights are rounded to f32 here, the precision of the file format, so a world in memory
     // is bit-identical to the same world loaded back from disk.
     let heights: Vec<f64> = fractions

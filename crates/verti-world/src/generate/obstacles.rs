@@ -66,16 +66,16 @@ fn seat_rock(
     y: f64,
     yaw: f64,
     world_scale: f64,
-) -> Obstacle {
+) -> Result<Obstacle, String> {
     let local = polytope_vertices(&faces);
     let reach = local.iter().map(|v| v.norm_xy()).fold(0.0, f64::max);
     let z_min_local = local.iter().map(|v| v.z).fold(f64::INFINITY, f64::min);
     let (ground, _) = terrain.range_in_box(x - reach, y - reach, x + reach, y + reach);
     let z = ground - ROCK_BURY * world_scale - z_min_local;
-    Obstacle::rock(faces, s, Vec3::new(x, y, z), yaw).expect("generated rock faces enclose a solid")
+    Obstacle::rock(faces, s, Vec3::new(x, y, z), yaw)
 }
 
-fn seat_tree(terrain: &Heightfield, x: f64, y: f64, world_scale: f64) -> Obstacle {
+fn seat_tree(terrain: &Heightfield, x: f64, y: f64, world_scale: f64) -> Result<Obstacle, String> {
     let r = TREE_RADIUS * world_scale;
     let h = TREE_HEIGHT * world_scale;
     let (ground, _) = terrain.range_in_box(x - r, y - r, x + r, y + r);
@@ -85,7 +85,6 @@ fn seat_tree(terrain: &Heightfield, x: f64, y: f64, world_scale: f64) -> Obstacl
         h + TREE_BURY * world_scale,
         Vec3::new(x, y, base + 0.5 * (h + TREE_BURY * world_scale)),
     )
-    .expect("tree size is positive")
 }
 
 /// Places the obstacles of a density. `keep_clear` are the start and goal points.
@@ -123,9 +122,16 @@ pub fn place_obstacles(
             let s = rng.range(0.7, 1.2);
             let faces = rock_faces(rng, s, world_scale);
             let yaw = rng.range(0.0, std::f64::consts::TAU);
-            out.push(seat_rock(terrain, faces, s, p[0], p[1], yaw, world_scale));
+            // an error here (a rock too small for f64) names the obstacle instead of panicking
+            out.push(
+                seat_rock(terrain, faces, s, p[0], p[1], yaw, world_scale)
+                    .map_err(|e| format!("rock {}: {e}", k + 1))?,
+            );
         } else {
-            out.push(seat_tree(terrain, p[0], p[1], world_scale));
+            out.push(
+                seat_tree(terrain, p[0], p[1], world_scale)
+                    .map_err(|e| format!("tree {}: {e}", k + 1 - rocks))?,
+            );
         }
     }
     Ok(out)
