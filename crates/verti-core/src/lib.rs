@@ -6,8 +6,10 @@
 //! * [`math`]: `Vec3`, `Quat` and `Mat3` in `f64`, just what a vehicle engine needs.
 //! * [`params`] and [`registry`]: typed, documented parameters and open registries of things
 //!   built by name from them (mobility systems, elevation sources).
+//! * [`messages`]: file-reading errors (serde) in plain words naming the field.
 
 pub mod math;
+pub mod messages;
 pub mod params;
 pub mod registry;
 pub mod rng;
