@@ -1,12 +1,13 @@
 //! `verti`: the command line of the verti off-road mobility benchmark.
 
 mod eval_cmd;
+mod outputs;
 mod progress;
 mod registries;
 mod vehicle_cmd;
 mod world_cmd;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -55,7 +56,8 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    let cli = Cli::parse();
+    let matches = outputs::check_outputs(Cli::command()).get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     if let Some(n) = cli.threads {
         if let Err(e) = verti_bench::eval::check_jobs(n, "--threads") {
             eprintln!("error: {e}");

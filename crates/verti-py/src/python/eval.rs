@@ -108,8 +108,12 @@ pub(super) fn param_value(name: &str, v: &Bound<'_, PyAny>) -> PyResult<ParamVal
         return Ok(ParamValue::Bool(v.extract::<bool>()?));
     }
     if v.is_instance_of::<pyo3::types::PyInt>() {
-        // a float would round a huge int to a nearby value; say what is wrong instead
-        return v.extract::<i64>().map(ParamValue::Int).map_err(|_| {
+        if let Ok(i) = v.extract::<i64>() {
+            return Ok(ParamValue::Int(i));
+        }
+        // beyond 64 bits it is outside every declared range; as a float the check says which
+        // range (`1e30 is outside [1, 65536]`), unless even a float cannot hold it
+        return v.extract::<f64>().map(ParamValue::Float).map_err(|_| {
             let digits = v.str().map(|s| s.to_string()).unwrap_or_default();
             value_err(format!(
                 "parameter {name}: the integer {} ({} digits) is outside the 64-bit range",
@@ -202,6 +206,9 @@ pub(super) fn evaluate(
             "resume=True continues the run in `out` and force=True discards it: pass one of them"
                 .into(),
         ));
+    }
+    if let Some(out) = &out {
+        out_dir_arg("out", out)?;
     }
     let setup = EvalArgs {
         worlds,

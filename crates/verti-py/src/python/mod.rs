@@ -102,6 +102,22 @@ pub(super) fn internal(p: Box<dyn std::any::Any + Send>) -> PyErr {
     ))
 }
 
+/// Checks an output directory argument (`out`, `World.save`'s path) as the command line does:
+/// it may be created, but only inside an existing directory (FileNotFoundError otherwise).
+pub(super) fn out_dir_arg(what: &str, path: &std::path::Path) -> PyResult<()> {
+    verti_core::output::check_output_dir(path).map_err(|problem| {
+        let message = format!("{what} {}: {problem}", path.display());
+        let parent_missing = path
+            .parent()
+            .is_some_and(|p| !p.as_os_str().is_empty() && !p.exists());
+        if parent_missing {
+            PyFileNotFoundError::new_err(message)
+        } else {
+            PyValueError::new_err(message)
+        }
+    })
+}
+
 /// Runs short work with the GIL released; a panic becomes `RuntimeError`.
 pub(super) fn detached<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
     py.detach(|| catch_unwind(AssertUnwindSafe(work)))
