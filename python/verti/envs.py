@@ -35,6 +35,13 @@ plane, a no-progress penalty, roll and pitch penalties beyond 30 degrees, and a 
 penalty by outcome. Pass ``reward={"progress": 10.0, ...}`` to change its weights, or a
 callable ``reward(obs, action, info) -> float`` to replace it (``info["default_reward"]`` and
 ``info["reward_terms"]`` hold the default and its parts).
+
+Processes: ``gym.make_vec(..., vectorization_mode="async")`` forks worker processes after the
+parent has made one environment (and so loaded its worlds in parallel). verti's parallel work
+runs on thread pools made for each call, never on a pool shared across calls, so a forked
+worker loads worlds and steps normally; a ``NavigateVectorEnv`` carried into a forked child
+starts new threads there. Between commands the workers wait on their pipe to the parent, so
+they exit when the parent dies, even when it is killed with SIGKILL.
 """
 
 from __future__ import annotations

@@ -124,19 +124,33 @@ pub(super) fn detached<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send)
         .map_err(internal)
 }
 
+/// A thread pool of its own for one call's parallel work (world loading and generation run
+/// rayon's `par_iter` inside it), never rayon's global pool: a process forked once the global
+/// pool has started (gymnasium's async vector env, `multiprocessing` with fork) inherits the
+/// pool's bookkeeping but none of its threads, and its first parallel call would wait forever.
+/// A pool made per call holds no state across a fork; it costs a few thread starts per call.
+fn call_pool() -> PyResult<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .thread_name(|i| format!("verti-{i}"))
+        .build()
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start worker threads: {e}")))
+}
+
 /// Runs long work on a helper thread with the GIL released while this thread checks for
 /// signals every 50 ms. On a signal (Ctrl-C) `cancel` is raised, the work (which polls it) is
-/// waited for, and the signal's exception (`KeyboardInterrupt`) is returned.
+/// waited for, and the signal's exception (`KeyboardInterrupt`) is returned. Parallel work
+/// inside runs on a pool made for this call (see `call_pool`).
 pub(super) fn interruptible<T: Send>(
     py: Python<'_>,
     cancel: &AtomicBool,
     work: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
+    let pool = call_pool()?;
     let (outcome, interrupted) = py.detach(|| {
         std::thread::scope(|s| {
             let (tx, rx) = std::sync::mpsc::channel::<()>();
             let handle = s.spawn(move || {
-                let r = catch_unwind(AssertUnwindSafe(work));
+                let r = catch_unwind(AssertUnwindSafe(|| pool.install(work)));
                 let _ = tx.send(());
                 r
             });
