@@ -7,7 +7,7 @@ fn error_for(edit: impl Fn(&str) -> String) -> String {
     let dir = std::env::temp_dir().join(format!("verti-spec-messages-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(format!("v{}.yaml", rand_suffix()));
-    std::fs::write(&path, edit(&vehicles::builtin_yaml("hmmwv").unwrap())).unwrap();
+    std::fs::write(&path, edit(vehicles::builtin_yaml("hmmwv").unwrap())).unwrap();
     let msg = VehicleSpec::from_file(&path).unwrap_err().to_string();
     std::fs::remove_file(&path).ok();
     let file = path.display().to_string();
