@@ -35,6 +35,13 @@ plane, a no-progress penalty, roll and pitch penalties beyond 30 degrees, and a 
 penalty by outcome. Pass ``reward={"progress": 10.0, ...}`` to change its weights, or a
 callable ``reward(obs, action, info) -> float`` to replace it (``info["default_reward"]`` and
 ``info["reward_terms"]`` hold the default and its parts).
+
+Processes: ``gym.make_vec(..., vectorization_mode="async")`` forks worker processes after the
+parent has made one environment (and so loaded its worlds in parallel). verti's parallel work
+runs on thread pools made for each call, never on a pool shared across calls, so a forked
+worker loads worlds and steps normally; a ``NavigateVectorEnv`` carried into a forked child
+starts new threads there. Between commands the workers wait on their pipe to the parent, so
+they exit when the parent dies, even when it is killed with SIGKILL.
 """
 
 from __future__ import annotations
@@ -89,6 +96,18 @@ def _resolve_worlds(world: WorldsArg, scale: float):
     if key not in _WORLD_CACHE:
         _WORLD_CACHE[key] = [World.resolve(world, scale)] if single else load_worlds(world, scale)
     return _WORLD_CACHE[key]
+
+
+def _count_arg(name: str, value: Any) -> int:
+    """A positive int argument; 2.0 is taken as 2, while 2.5 or True is refused rather than
+    truncated (the same rule as integer parameters of systems)."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be a positive int, not {value!r}")
+    if isinstance(value, (float, np.floating)) and float(value).is_integer():
+        value = int(value)
+    if not isinstance(value, (int, np.integer)) or value < 1:
+        raise ValueError(f"{name} must be a positive int, not {value!r}")
+    return int(value)
 
 
 def _settings(
@@ -234,7 +253,7 @@ class NavigateEnv(gym.Env):
         self._task = None if task is None else int(task)
         self._sampler_seeded = False
         self.render_mode = render_mode
-        self._pixels_per_cell = int(render_pixels_per_cell)
+        self._pixels_per_cell = _count_arg("render_pixels_per_cell", render_pixels_per_cell)
         self.observation_space = _observation_space(self._core.observation_layout)
         self.action_space = _action_space(self._core.action_mode)
         self.metadata = dict(self.metadata, render_fps=int(round(self._core.control_rate)))
@@ -327,8 +346,7 @@ class NavigateVectorEnv(VectorEnv):
     ):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array', not {render_mode!r}")
-        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
-            raise ValueError(f"num_envs must be a positive int, not {num_envs!r}")
+        num_envs = _count_arg("num_envs", num_envs)
         settings = _settings(
             tasks=tasks,
             levels=levels,
@@ -352,7 +370,7 @@ class NavigateVectorEnv(VectorEnv):
         self._sampler_seeded = False
         self.num_envs = int(num_envs)
         self.render_mode = render_mode
-        self._pixels_per_cell = int(render_pixels_per_cell)
+        self._pixels_per_cell = _count_arg("render_pixels_per_cell", render_pixels_per_cell)
         self.single_observation_space = _observation_space(self._core.observation_layout)
         self.single_action_space = _action_space(self._core.action_mode)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)

@@ -125,7 +125,7 @@ impl RunRecord {
         serde_json::from_str(&text).map_err(|e| EvalError::Corrupt {
             path: path.to_path_buf(),
             line: e.line(),
-            problem: e.to_string(),
+            problem: verti_core::messages::explain_serde_error(&e.to_string()),
         })
     }
 

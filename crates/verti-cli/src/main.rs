@@ -2,12 +2,13 @@
 
 mod compare_cmd;
 mod eval_cmd;
+mod outputs;
 mod progress;
 mod registries;
 mod vehicle_cmd;
 mod world_cmd;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -56,7 +57,8 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    let cli = Cli::parse();
+    let matches = outputs::check_outputs(Cli::command()).get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     if let Some(n) = cli.threads {
         if let Err(e) = verti_bench::eval::check_jobs(n, "--threads") {
             eprintln!("error: {e}");

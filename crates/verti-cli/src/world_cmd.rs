@@ -35,8 +35,8 @@ pub enum WorldCommand {
 pub struct RenderArgs {
     /// A world directory or SET:INDEX (e.g. verti-100:42).
     world: String,
-    /// Output PNG.
-    #[arg(long)]
+    /// Output PNG (a .png file in an existing directory).
+    #[arg(long, value_parser = crate::outputs::png_file)]
     out: PathBuf,
     /// Pixels per heightfield cell.
     #[arg(long, default_value_t = 4)]
@@ -59,7 +59,7 @@ pub struct StatsArgs {
     #[arg(long)]
     json: bool,
     /// Also write the per-level elevation histograms (like the paper's Fig. 2) to this PNG.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::outputs::png_file)]
     histograms: Option<PathBuf>,
     #[command(flatten)]
     scale: ScaleArg,
@@ -104,8 +104,8 @@ pub struct GenerateArgs {
     /// Elevation source parameter, name=value (repeatable).
     #[arg(long = "elevation-param", value_parser = crate::eval_cmd::assignment)]
     elevation_params: Vec<String>,
-    /// Output directory (default: worlds/<set name>).
-    #[arg(long)]
+    /// Output directory (default: worlds/<set name>); its parent must exist.
+    #[arg(long, value_parser = crate::outputs::out_dir)]
     out: Option<PathBuf>,
     /// Overwrite an existing non-empty output directory.
     #[arg(long)]
@@ -130,8 +130,8 @@ pub struct ImportArgs {
     /// Path clearance from obstacles, full-scale metres.
     #[arg(long, default_value_t = DEFAULT_CLEARANCE)]
     clearance: f64,
-    /// Output: a world directory (one config) or a set directory (--dir).
-    #[arg(long)]
+    /// Output: a world directory (one config) or a set directory (--dir); its parent must exist.
+    #[arg(long, value_parser = crate::outputs::out_dir)]
     out: PathBuf,
     /// Overwrite an existing non-empty output directory.
     #[arg(long)]
@@ -341,14 +341,11 @@ fn stats(a: StatsArgs) -> CmdResult {
     Ok(())
 }
 
-/// Creates the parent folder of an output file.
+/// Checks that an output file can be written: a picture format verti writes, in a directory
+/// that exists. Missing directories are not created (a typo should not grow a tree).
 pub fn ensure_parent(path: &Path) -> Result<(), WorldError> {
-    match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => {
-            std::fs::create_dir_all(p).map_err(|e| WorldError::io(p, e))
-        }
-        _ => Ok(()),
-    }
+    verti_core::output::check_output_file(path, verti_core::output::IMAGE_FORMATS)
+        .map_err(|problem| WorldError::Argument(format!("{}: {problem}", path.display())))
 }
 
 /// A short multi-line description of a world.

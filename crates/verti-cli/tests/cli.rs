@@ -332,3 +332,75 @@ fn tiny_scales_are_errors_and_empty_folders_do_not_hide_built_in_sets() {
     );
     std::fs::remove_dir_all(cwd).ok();
 }
+
+#[test]
+fn outputs_must_be_png_files_in_existing_directories() {
+    let dir = tmp("outputs");
+    std::fs::create_dir_all(&dir).unwrap();
+    let d = |p: &str| dir.join(p).to_str().unwrap().to_string();
+    // pictures: another extension is refused, with the formats that are supported
+    for args in [
+        vec!["world", "render", "verti-1:1", "--out", &d("w.jpg")],
+        vec!["world", "stats", "verti-1", "--histograms", &d("h.bmp")],
+        vec!["replay", &d("run"), "--task", "1", "--out", &d("t.jpeg")],
+    ] {
+        let e = run_err(&args);
+        assert!(
+            e.contains("is not a supported format; supported: .png"),
+            "{args:?}: {e}"
+        );
+    }
+    let e = run_err(&["world", "render", "verti-1:1", "--out", &d("w")]);
+    assert!(e.contains("no extension; supported: .png"), "{e}");
+    // no command creates a missing parent directory
+    let typo = dir.join("typo");
+    for args in [
+        vec!["world", "render", "verti-1:1", "--out", &d("typo/a/w.png")],
+        vec![
+            "world",
+            "stats",
+            "verti-1",
+            "--histograms",
+            &d("typo/a/h.png"),
+        ],
+        vec![
+            "replay",
+            &d("run"),
+            "--task",
+            "1",
+            "--out",
+            &d("typo/a/t.png"),
+        ],
+        vec!["report", &d("run"), "--out", &d("typo/a/report")],
+        vec!["eval", "--worlds", "verti-1", "--out", &d("typo/a/run")],
+        vec![
+            "world",
+            "generate",
+            "--count",
+            "1",
+            "--out",
+            &d("typo/a/set"),
+        ],
+        vec![
+            "world",
+            "import-vb",
+            "--dir",
+            &d("vb"),
+            "--out",
+            &d("typo/a/vb"),
+        ],
+    ] {
+        let e = run_err(&args);
+        assert!(
+            e.contains(&format!(
+                "directory {} does not exist",
+                typo.join("a").display()
+            )),
+            "{args:?}: {e}"
+        );
+    }
+    assert!(!typo.exists(), "a directory was created");
+    // an output directory itself may be new when its parent exists
+    run_ok(&["world", "render", "verti-1:1", "--out", &d("w.PNG")]);
+    assert!(dir.join("w.PNG").is_file());
+}

@@ -7,9 +7,13 @@
 //! * [`digest`]: content digests, so a run records what it ran by content.
 //! * [`params`] and [`registry`]: typed, documented parameters and open registries of things
 //!   built by name from them (mobility systems, elevation sources).
+//! * [`messages`]: file-reading errors (serde) in plain words naming the field.
+//! * [`output`]: checks of output paths (known format, existing parent directory).
 
 pub mod digest;
 pub mod math;
+pub mod messages;
+pub mod output;
 pub mod params;
 pub mod registry;
 pub mod rng;

@@ -145,22 +145,34 @@ impl Serialize for ParamValue {
 
 /// Reads back what [`Serialize`] wrote: integers as `Int`, other numbers as `Float`, strings
 /// as `Str` (resolution against the declaration turns them into paths where declared so).
+/// Written as a visitor rather than an untagged enum so that a bad value is reported as what
+/// it is ("expected a number, true/false or text") instead of "did not match any variant".
 impl<'de> Deserialize<'de> for ParamValue {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        #[derive(Deserialize)]
-        #[serde(untagged)]
-        enum Json {
-            Bool(bool),
-            Int(i64),
-            Float(f64),
-            Str(String),
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = ParamValue;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a parameter value (a number, true/false or text)")
+            }
+            fn visit_bool<E: serde::de::Error>(self, v: bool) -> Result<ParamValue, E> {
+                Ok(ParamValue::Bool(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<ParamValue, E> {
+                Ok(ParamValue::Int(v))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<ParamValue, E> {
+                // beyond i64 it can only be out of any declared integer range; keep the number
+                Ok(i64::try_from(v).map_or(ParamValue::Float(v as f64), ParamValue::Int))
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<ParamValue, E> {
+                Ok(ParamValue::Float(v))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<ParamValue, E> {
+                Ok(ParamValue::Str(v.to_string()))
+            }
         }
-        Ok(match Json::deserialize(d)? {
-            Json::Bool(v) => ParamValue::Bool(v),
-            Json::Int(v) => ParamValue::Int(v),
-            Json::Float(v) => ParamValue::Float(v),
-            Json::Str(v) => ParamValue::Str(v),
-        })
+        d.deserialize_any(V)
     }
 }
 
@@ -212,26 +224,35 @@ impl ParamSpec {
         ParamError(format!("{owner} parameter {}: {what}", self.name))
     }
 
-    /// Reads a value from text (e.g. `--param name=value`) per the declared type, and checks it.
+    /// Reads a value from text (e.g. `--param name=value`) per the declared type, and checks it
+    /// with [`ParamSpec::check`], the same check Python values get, so the command line and
+    /// Python accept the same values: `2.0` and `2` for an int, never `2.5`.
     pub fn parse(&self, owner: &str, text: &str) -> Result<ParamValue, ParamError> {
         let t = text.trim();
         let v = match &self.kind {
-            ParamKind::Float { .. } => ParamValue::Float(
-                t.parse()
-                    .map_err(|_| self.err(owner, format!("`{t}` is not a number")))?,
-            ),
-            ParamKind::Int { .. } => match t.parse::<i64>() {
+            ParamKind::Float { .. } => match t.parse() {
+                Ok(x) => ParamValue::Float(x),
+                Err(_) => return Err(self.err(owner, format!("{} is not a number", quote(t)))),
+            },
+            ParamKind::Int { min, max } => match t.parse::<i64>() {
                 Ok(i) => ParamValue::Int(i),
-                // `64.0` is accepted for 64, as before parameters were typed
+                // digits only, yet not an i64: an integer far outside any declared range
+                Err(_) if is_integer_literal(t) => {
+                    return Err(self.err(owner, format!("{} is outside [{min}, {max}]", quote(t))));
+                }
+                // `64.0` or `1e3` is an exact integer written as a number; `check` refuses the
+                // rest (2.5, NaN, 1e300)
                 Err(_) => ParamValue::Float(
                     t.parse()
-                        .map_err(|_| self.err(owner, format!("`{t}` is not an integer")))?,
+                        .map_err(|_| self.err(owner, format!("{} is not an integer", quote(t))))?,
                 ),
             },
             ParamKind::Bool => ParamValue::Bool(match t.to_ascii_lowercase().as_str() {
                 "true" | "1" | "yes" | "on" => true,
                 "false" | "0" | "no" | "off" => false,
-                _ => return Err(self.err(owner, format!("`{t}` is not true or false"))),
+                _ => {
+                    return Err(self.err(owner, format!("{} is not true or false", quote(t))));
+                }
             }),
             ParamKind::Str { .. } => ParamValue::Str(t.to_string()),
             ParamKind::Path => ParamValue::Path(PathBuf::from(t)),
@@ -241,14 +262,9 @@ impl ParamSpec {
 
     /// Checks a value against the declaration, converting where nothing is lost (an integer
     /// for a float, an integral float for an integer, text for a path and back); returns the
-    /// value in the declared type.
+    /// value in the declared type. Every refusal names the parameter, the value and what the
+    /// parameter accepts.
     pub fn check(&self, owner: &str, value: ParamValue) -> Result<ParamValue, ParamError> {
-        let wrong = |v: &ParamValue| {
-            self.err(
-                owner,
-                format!("expected {}, got `{v}`", self.kind.type_name()),
-            )
-        };
         match (&self.kind, value) {
             (ParamKind::Float { min, max }, v @ (ParamValue::Float(_) | ParamValue::Int(_))) => {
                 let x = match v {
@@ -256,16 +272,33 @@ impl ParamSpec {
                     ParamValue::Float(x) => x,
                     _ => unreachable!(),
                 };
-                if !(x.is_finite() && x >= *min && x <= *max) {
-                    return Err(self.err(owner, format!("{x} is outside [{min}, {max}]")));
+                if !x.is_finite() {
+                    return Err(self.err(owner, format!("`{x}` is not a finite number")));
+                }
+                if !(x >= *min && x <= *max) {
+                    let shown = show_float(x);
+                    return Err(self.err(owner, format!("{shown} is outside [{min}, {max}]")));
                 }
                 Ok(ParamValue::Float(x))
             }
             (ParamKind::Int { min, max }, v @ (ParamValue::Float(_) | ParamValue::Int(_))) => {
                 let i = match v {
                     ParamValue::Int(i) => i,
-                    ParamValue::Float(x) if x.fract() == 0.0 && x.abs() < 9.0e15 => x as i64,
-                    v => return Err(self.err(owner, format!("`{v}` is not an integer"))),
+                    ParamValue::Float(x) if x.is_finite() && x.fract() == 0.0 => {
+                        // an exact integer; beyond i64 it is outside every declared range
+                        if x.abs() >= 9.0e18 {
+                            let shown = show_float(x);
+                            return Err(
+                                self.err(owner, format!("{shown} is outside [{min}, {max}]"))
+                            );
+                        }
+                        x as i64
+                    }
+                    ParamValue::Float(x) => {
+                        let shown = show_float(x);
+                        return Err(self.err(owner, format!("`{shown}` is not an integer")));
+                    }
+                    _ => unreachable!(),
                 };
                 if i < *min || i > *max {
                     return Err(self.err(owner, format!("{i} is outside [{min}, {max}]")));
@@ -276,9 +309,10 @@ impl ParamSpec {
             (ParamKind::Str { choices }, v @ (ParamValue::Str(_) | ParamValue::Path(_))) => {
                 let s = v.to_string();
                 if !choices.is_empty() && !choices.contains(&s) {
-                    return Err(
-                        self.err(owner, format!("`{s}` is not one of {}", choices.join(", ")))
-                    );
+                    return Err(self.err(
+                        owner,
+                        format!("{} is not one of {}", quote(&s), choices.join(", ")),
+                    ));
                 }
                 Ok(ParamValue::Str(s))
             }
@@ -289,13 +323,50 @@ impl ParamSpec {
                     _ => unreachable!(),
                 };
                 if !p.as_os_str().is_empty() && !p.exists() {
-                    return Err(self.err(owner, format!("`{}` does not exist", p.display())));
+                    let shown = quote(&p.display().to_string());
+                    return Err(self.err(owner, format!("{shown} does not exist")));
                 }
                 Ok(ParamValue::Path(p))
             }
-            (_, v) => Err(wrong(&v)),
+            (_, v) => {
+                let shown = match &v {
+                    ParamValue::Float(x) => format!("`{}`", show_float(*x)),
+                    other => quote(&other.to_string()),
+                };
+                Err(self.err(
+                    owner,
+                    format!("expected {}, got {shown}", self.kind.type_name()),
+                ))
+            }
         }
     }
+}
+
+/// `text` in backquotes for a message, shortened when long, so a pasted blob or a 300-digit
+/// number does not drown the message.
+fn quote(text: &str) -> String {
+    const MAX: usize = 40;
+    if text.chars().count() <= MAX {
+        format!("`{text}`")
+    } else {
+        let head: String = text.chars().take(MAX).collect();
+        format!("`{head}...` ({} characters)", text.chars().count())
+    }
+}
+
+/// A float as people write it: `2.5`, `100`, and `1e300` rather than 301 digits.
+fn show_float(x: f64) -> String {
+    if x.is_finite() && x != 0.0 && !(1e-6..1e16).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+/// An optional sign then ASCII digits: text that means an integer even where i64 cannot hold it.
+fn is_integer_literal(t: &str) -> bool {
+    let digits = t.strip_prefix(['+', '-']).unwrap_or(t);
+    !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
 }
 
 /// Finds a declaration or says which ones exist.
@@ -360,8 +431,14 @@ impl Params {
             .iter()
             .map(|s| (s.name.clone(), s.default.clone()))
             .collect();
-        for (name, v) in given {
+        for (k, (name, v)) in given.iter().enumerate() {
             let spec = spec_named(owner, &specs, name)?;
+            // `--param samples=10 --param samples=20` would otherwise keep one of them silently
+            if given[..k].iter().any(|(n, _)| n == name) {
+                return Err(ParamError(format!(
+                    "{owner} parameter {name} is given twice"
+                )));
+            }
             let i = specs
                 .iter()
                 .position(|s| s.name == spec.name)

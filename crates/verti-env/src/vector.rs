@@ -28,7 +28,16 @@ pub struct VecCore {
     /// Reset by the next step.
     pub pending_reset: Vec<bool>,
     pool: rayon::ThreadPool,
+    /// The process the pool's threads run in (see [`VecCore::fresh_pool`]).
+    pool_pid: u32,
     threads: usize,
+}
+
+fn build_pool(threads: usize) -> Result<rayon::ThreadPool, EnvError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| EnvError::InvalidConfig(format!("cannot start {threads} worker threads: {e}")))
 }
 
 impl VecCore {
@@ -39,12 +48,7 @@ impl VecCore {
                 "num_envs must be at least 1".into(),
             ));
         }
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| {
-                EnvError::InvalidConfig(format!("cannot start {threads} worker threads: {e}"))
-            })?;
+        let pool = build_pool(threads)?;
         let envs: Vec<EnvCore> = (0..n).map(|i| template.sibling(i as u64)).collect();
         Ok(VecCore {
             obs: vec![ObsBuf::default(); n],
@@ -52,8 +56,23 @@ impl VecCore {
             pending_reset: vec![false; n],
             envs,
             pool,
+            pool_pid: std::process::id(),
             threads,
         })
+    }
+
+    /// Starts a new pool when this value lives in a forked child (Python's `multiprocessing`
+    /// or gymnasium's async vector env forking a process that holds it): a fork copies the
+    /// pool's bookkeeping but none of its threads, so work handed to it would wait forever.
+    /// The copy is leaked, not dropped: dropping it would signal threads that do not exist.
+    fn fresh_pool(&mut self) -> Result<(), EnvError> {
+        let pid = std::process::id();
+        if pid != self.pool_pid {
+            let stale = std::mem::replace(&mut self.pool, build_pool(self.threads)?);
+            std::mem::forget(stale);
+            self.pool_pid = pid;
+        }
+        Ok(())
     }
 
     pub fn len(&self) -> usize {
@@ -74,6 +93,7 @@ impl VecCore {
                 s.len()
             )));
         }
+        self.fresh_pool()?;
         let envs = &mut self.envs;
         let obs = &mut self.obs;
         self.pool.install(|| {
@@ -123,6 +143,7 @@ impl VecCore {
                 }
                 env.observe(buf).map_err(|e| e.in_vector(i))
             };
+        self.fresh_pool()?;
         let (envs, obs, reports, pending) = (
             &mut self.envs,
             &mut self.obs,

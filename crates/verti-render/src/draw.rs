@@ -32,8 +32,15 @@ pub(crate) fn ensure_font() -> Result<(), RenderError> {
     }
 }
 
-/// Writes an image as PNG.
+/// Writes an image as PNG. The path must end in `.png` and its directory must exist: a file
+/// named `.jpg` holding PNG bytes, or a directory tree grown from a typo, helps no one.
 pub fn save_png(image: &RgbImage, path: &Path) -> Result<(), RenderError> {
+    verti_core::output::check_output_file(path, verti_core::output::IMAGE_FORMATS).map_err(
+        |problem| RenderError::Output {
+            path: path.to_path_buf(),
+            problem,
+        },
+    )?;
     image
         .save_with_format(path, ImageFormat::Png)
         .map_err(|source| RenderError::Write {

@@ -48,6 +48,9 @@ pub enum RenderError {
     /// The data to draw is inconsistent (e.g. a speed per trajectory point is missing).
     #[error("invalid input: {0}")]
     Input(String),
+    /// The output path is not one verti writes to (another extension, a missing directory).
+    #[error("cannot write {}: {problem}", path.display())]
+    Output { path: PathBuf, problem: String },
     /// Writing the PNG failed.
     #[error("cannot write {}: {source}", path.display())]
     Write {

@@ -175,6 +175,34 @@ fn options_and_inputs_are_checked() {
 }
 
 #[test]
+fn pictures_are_written_only_as_png_into_existing_directories() {
+    let img = render_world(&worlds()[0], &RenderOptions::default()).unwrap();
+    let dir = out_dir("formats");
+    let e = img.save_png(&dir.join("w.jpg")).unwrap_err().to_string();
+    assert!(
+        e.contains("w.jpg: `.jpg` is not a supported format; supported: .png"),
+        "{e}"
+    );
+    assert!(!dir.join("w.jpg").exists());
+    let e = img.save_png(&dir.join("w")).unwrap_err().to_string();
+    assert!(e.contains("no extension; supported: .png"), "{e}");
+    let missing = dir.join("typo");
+    let e = img
+        .save_png(&missing.join("deeper/w.png"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(&format!(
+            "directory {} does not exist",
+            missing.join("deeper").display()
+        )),
+        "{e}"
+    );
+    assert!(!missing.exists(), "no directory is created");
+    img.save_png(&dir.join("w.PNG")).unwrap();
+}
+
+#[test]
 fn trajectory_is_coloured_by_speed_and_failure_is_marked() {
     let w = &worlds()[2];
     let mut img = render_world(

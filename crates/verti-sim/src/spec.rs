@@ -200,7 +200,8 @@ pub struct TrackSpec {
 }
 
 impl VehicleSpec {
-    /// Parses and validates a vehicle from YAML text. `origin` names the source in errors.
+    /// Parses and validates a vehicle from YAML text. `origin` names the source in errors,
+    /// which name the field by its path (``ORIGIN: field `chassis.mass` is missing``).
     pub fn from_yaml_str(text: &str, origin: &str) -> Result<VehicleSpec, SpecError> {
         // text from any source (a file, Python) gets the size and nesting limits every verti
         // YAML input has, before the parser sees it
@@ -211,10 +212,21 @@ impl VehicleSpec {
                 problem: r.problem,
             },
         )?;
-        let spec: VehicleSpec = serde_norway::from_str(text).map_err(|e| SpecError::Parse {
+        let parse_error = |message: String| SpecError::Parse {
             origin: origin.to_string(),
-            message: e.to_string(),
-        })?;
+            message,
+        };
+        // an empty file (or one of comments only) would otherwise report its first field missing
+        if text.lines().all(|l| {
+            let l = l.trim();
+            l.is_empty() || l.starts_with('#') || l == "---"
+        }) {
+            return Err(parse_error(
+                "the file is empty; a vehicle file is a mapping of fields (see `verti vehicle show hmmwv --yaml`)".into(),
+            ));
+        }
+        let spec: VehicleSpec = serde_norway::from_str(text)
+            .map_err(|e| parse_error(verti_core::messages::explain_serde_error(&e.to_string())))?;
         spec.validate(origin)?;
         Ok(spec)
     }

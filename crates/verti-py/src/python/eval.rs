@@ -99,22 +99,48 @@ pub(super) fn system_registry() -> verti_bench::SystemRegistry {
     r
 }
 
-/// One parameter value: bool, int, float, str or a path (`pathlib.Path`); checked against
-/// the declared type when resolved.
-pub(super) fn param_value(v: &Bound<'_, PyAny>) -> Option<ParamValue> {
+/// One parameter value: bool, int, float, str or a path (`pathlib.Path`), as the same
+/// `ParamValue` the command line's text becomes, so both are checked by the same
+/// `ParamSpec::check` (an int parameter takes 2 and 2.0, never 2.5). `name` names the parameter
+/// in the error for a value of another type or an int beyond 64 bits.
+pub(super) fn param_value(name: &str, v: &Bound<'_, PyAny>) -> PyResult<ParamValue> {
     if v.is_instance_of::<pyo3::types::PyBool>() {
-        return v.extract::<bool>().ok().map(ParamValue::Bool);
+        return Ok(ParamValue::Bool(v.extract::<bool>()?));
+    }
+    if v.is_instance_of::<pyo3::types::PyInt>() {
+        if let Ok(i) = v.extract::<i64>() {
+            return Ok(ParamValue::Int(i));
+        }
+        // beyond 64 bits it is outside every declared range; as a float the check says which
+        // range (`1e30 is outside [1, 65536]`), unless even a float cannot hold it
+        return v.extract::<f64>().map(ParamValue::Float).map_err(|_| {
+            let digits = v.str().map(|s| s.to_string()).unwrap_or_default();
+            value_err(format!(
+                "parameter {name}: the integer {} ({} digits) is outside the 64-bit range",
+                &digits[..digits.len().min(20)],
+                digits.trim_start_matches('-').len()
+            ))
+        });
     }
     if let Ok(i) = v.extract::<i64>() {
-        return Some(ParamValue::Int(i));
+        return Ok(ParamValue::Int(i));
     }
     if let Ok(x) = v.extract::<f64>() {
-        return Some(ParamValue::Float(x));
+        return Ok(ParamValue::Float(x));
     }
     if let Ok(t) = v.extract::<String>() {
-        return Some(ParamValue::Str(t));
+        return Ok(ParamValue::Str(t));
     }
-    v.extract::<PathBuf>().ok().map(ParamValue::Path)
+    v.extract::<PathBuf>().map(ParamValue::Path).map_err(|_| {
+        let kind = v
+            .get_type()
+            .name()
+            .map(|n| n.to_string())
+            .unwrap_or_default();
+        PyTypeError::new_err(format!(
+            "parameter {name}: a value of type {kind} is not a parameter value; give a number, bool, str or path"
+        ))
+    })
 }
 
 /// System parameters: None, a dict name -> value, or a list of (name, value) pairs.
@@ -128,10 +154,9 @@ pub(super) fn params_arg(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String
         )
     };
     let pair = |k: &Bound<'_, PyAny>, v: &Bound<'_, PyAny>| {
-        Ok((
-            k.extract::<String>().map_err(|_| bad())?,
-            param_value(v).ok_or_else(bad)?,
-        ))
+        let name = k.extract::<String>().map_err(|_| bad())?;
+        let value = param_value(&name, v)?;
+        Ok((name, value))
     };
     if let Ok(d) = arg.cast::<PyDict>() {
         return d.iter().map(|(k, v)| pair(&k, &v)).collect();
@@ -181,6 +206,9 @@ pub(super) fn evaluate(
             "resume=True continues the run in `out` and force=True discards it: pass one of them"
                 .into(),
         ));
+    }
+    if let Some(out) = &out {
+        out_dir_arg("out", out)?;
     }
     let setup = EvalArgs {
         worlds,

@@ -102,25 +102,55 @@ pub(super) fn internal(p: Box<dyn std::any::Any + Send>) -> PyErr {
     ))
 }
 
+/// Checks an output directory argument (`out`, `World.save`'s path) as the command line does:
+/// it may be created, but only inside an existing directory (FileNotFoundError otherwise).
+pub(super) fn out_dir_arg(what: &str, path: &std::path::Path) -> PyResult<()> {
+    verti_core::output::check_output_dir(path).map_err(|problem| {
+        let message = format!("{what} {}: {problem}", path.display());
+        let parent_missing = path
+            .parent()
+            .is_some_and(|p| !p.as_os_str().is_empty() && !p.exists());
+        if parent_missing {
+            PyFileNotFoundError::new_err(message)
+        } else {
+            PyValueError::new_err(message)
+        }
+    })
+}
+
 /// Runs short work with the GIL released; a panic becomes `RuntimeError`.
 pub(super) fn detached<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
     py.detach(|| catch_unwind(AssertUnwindSafe(work)))
         .map_err(internal)
 }
 
+/// A thread pool of its own for one call's parallel work (world loading and generation run
+/// rayon's `par_iter` inside it), never rayon's global pool: a process forked once the global
+/// pool has started (gymnasium's async vector env, `multiprocessing` with fork) inherits the
+/// pool's bookkeeping but none of its threads, and its first parallel call would wait forever.
+/// A pool made per call holds no state across a fork; it costs a few thread starts per call.
+fn call_pool() -> PyResult<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .thread_name(|i| format!("verti-{i}"))
+        .build()
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start worker threads: {e}")))
+}
+
 /// Runs long work on a helper thread with the GIL released while this thread checks for
 /// signals every 50 ms. On a signal (Ctrl-C) `cancel` is raised, the work (which polls it) is
-/// waited for, and the signal's exception (`KeyboardInterrupt`) is returned.
+/// waited for, and the signal's exception (`KeyboardInterrupt`) is returned. Parallel work
+/// inside runs on a pool made for this call (see `call_pool`).
 pub(super) fn interruptible<T: Send>(
     py: Python<'_>,
     cancel: &AtomicBool,
     work: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
+    let pool = call_pool()?;
     let (outcome, interrupted) = py.detach(|| {
         std::thread::scope(|s| {
             let (tx, rx) = std::sync::mpsc::channel::<()>();
             let handle = s.spawn(move || {
-                let r = catch_unwind(AssertUnwindSafe(work));
+                let r = catch_unwind(AssertUnwindSafe(|| pool.install(work)));
                 let _ = tx.send(());
                 r
             });

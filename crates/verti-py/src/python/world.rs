@@ -144,9 +144,11 @@ impl PyWorld {
     }
 
     /// Writes the world as a directory in verti's format. An existing directory is replaced
-    /// only with `overwrite=True` (like the CLI's `--force`).
+    /// only with `overwrite=True` (like the CLI's `--force`); a missing parent directory is
+    /// not created.
     #[pyo3(signature = (path, overwrite = false))]
     fn save(&self, py: Python<'_>, path: PathBuf, overwrite: bool) -> PyResult<()> {
+        out_dir_arg("path", &path)?;
         if !overwrite && path.exists() {
             return Err(pyo3::exceptions::PyFileExistsError::new_err(format!(
                 "{} already exists: pass overwrite=True to replace it",
