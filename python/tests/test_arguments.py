@@ -60,3 +60,26 @@ def test_render_resolution_takes_exact_integers_only(world):
     env = NavigateEnv(world, render_mode="rgb_array", render_pixels_per_cell=2.0)
     env.reset(seed=0)
     assert env.render().shape[2] == 3
+
+
+def test_a_saved_set_keeps_its_scale_and_picks_its_vehicle(tmp_path):
+    # the command line's rule: --scale for a saved set must match it, and the default vehicle
+    # follows the worlds' scale
+    small = verti.World.generate_set(seed=3, count=1, scale=1 / 6)
+    small[0].save(str(tmp_path / "w"))
+    with pytest.raises(ValueError, match="does not apply .* saved at scale 1/6"):
+        verti.World.resolve(str(tmp_path / "w"), scale=0.1)
+    with pytest.raises(ValueError, match="does not apply"):
+        verti.evaluate("pid", [small[0]], tasks=[1], max_time=1.0, scale=1.0)
+    (r,) = verti.evaluate("pid", str(tmp_path / "w"), tasks=[1], max_time=1.0)
+    assert r["vehicle"] == "artcar"
+    with pytest.warns(UserWarning, match="vehicle hmmwv is built for scale 1 but the worlds are at scale 1/6"):
+        verti.evaluate("pid", [small[0]], tasks=[1], max_time=1.0, vehicle="hmmwv")
+
+
+def test_start_is_settled_or_drop(world):
+    (settled,) = verti.evaluate("pid", [world], tasks=[1], max_time=2.0)
+    (dropped,) = verti.evaluate("pid", [world], tasks=[1], max_time=2.0, start="drop")
+    assert settled["path_length"] != dropped["path_length"]
+    with pytest.raises(ValueError, match='unknown start "fly"'):
+        verti.evaluate("pid", [world], tasks=[1], start="fly")

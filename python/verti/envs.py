@@ -85,14 +85,14 @@ RewardArg = Union[None, Dict[str, float], Callable[[Dict[str, np.ndarray], np.nd
 _WORLD_CACHE: Dict[Any, Any] = {}
 
 
-def _resolve_worlds(world: WorldsArg, scale: float):
+def _resolve_worlds(world: WorldsArg, scale: Optional[float]):
     if not isinstance(world, str):
         return world
     base, _, index = world.rpartition(":")
     single = bool(base) and index.isdigit()
     if os.path.exists(base if single else world):
         return world
-    key = (world, float(scale))
+    key = (world, None if scale is None else float(scale))
     if key not in _WORLD_CACHE:
         _WORLD_CACHE[key] = [World.resolve(world, scale)] if single else load_worlds(world, scale)
     return _WORLD_CACHE[key]
@@ -179,12 +179,14 @@ class NavigateEnv(gym.Env):
             Verti-Bench worlds.
         task: a global task number (world 1 pair 0 is 1, world 100 pair 9 is 1000) to run
             every episode; default: sample from the tasks selected by the filters below.
-        vehicle: built-in vehicle name (``verti.vehicles()``) or a vehicle YAML file.
+        vehicle: built-in vehicle name (``verti.vehicles()``) or a vehicle YAML file (default:
+            the one for the worlds' scale: hmmwv, artcar at 1/6, verti4 at 1/10).
         tasks: task numbers to sample from (list or range string such as ``"1-50"``).
         levels, densities, terrain_types: keep only worlds of these elevation levels
             (low/mid/high), obstacle densities (sparse/medium/dense) and terrain types
             (rigid/deformable/mixed) in the sampler, e.g. for a curriculum.
-        scale: world scale used when ``world`` is a name.
+        scale: world scale used when ``world`` names a generated or imported set (default 1);
+            saved worlds keep theirs, and another scale for them is an error.
         control_rate: actions per simulated second (10 Hz: each step is 0.1 s).
         action_mode: ``"high"`` (target speed, steering) or ``"low"`` (throttle, brake, steering).
         max_speed: full-scale m/s of a high-level speed action of 1.
@@ -205,13 +207,13 @@ class NavigateEnv(gym.Env):
         self,
         world: WorldsArg = "verti-100",
         task: Optional[int] = None,
-        vehicle: str = "hmmwv",
+        vehicle: Optional[str] = None,
         *,
         tasks: Union[None, str, Sequence[int]] = None,
         levels: Union[None, str, Sequence[str]] = None,
         densities: Union[None, str, Sequence[str]] = None,
         terrain_types: Union[None, str, Sequence[str]] = None,
-        scale: float = 1.0,
+        scale: Optional[float] = None,
         control_rate: float = 10.0,
         action_mode: str = "high",
         max_speed: float = 4.0,
@@ -322,14 +324,14 @@ class NavigateVectorEnv(VectorEnv):
         self,
         num_envs: int = 8,
         world: WorldsArg = "verti-100",
-        vehicle: str = "hmmwv",
+        vehicle: Optional[str] = None,
         *,
         num_threads: Optional[int] = None,
         tasks: Union[None, str, Sequence[int]] = None,
         levels: Union[None, str, Sequence[str]] = None,
         densities: Union[None, str, Sequence[str]] = None,
         terrain_types: Union[None, str, Sequence[str]] = None,
-        scale: float = 1.0,
+        scale: Optional[float] = None,
         control_rate: float = 10.0,
         action_mode: str = "high",
         max_speed: float = 4.0,

@@ -89,17 +89,6 @@ pub struct EvalArgs {
     log_steps: Option<String>,
 }
 
-/// The default vehicle for a world scale.
-fn default_vehicle(scale: f64) -> &'static str {
-    if (scale - 1.0 / 6.0).abs() < 1e-3 {
-        "artcar"
-    } else if (scale - 0.1).abs() < 1e-3 {
-        "verti4"
-    } else {
-        "hmmwv"
-    }
-}
-
 pub fn eval(a: EvalArgs) -> CmdResult {
     let registry = crate::registries::systems();
     let given = a
@@ -115,7 +104,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
     let vehicle_name = a
         .vehicle
         .clone()
-        .unwrap_or_else(|| default_vehicle(scale).to_string());
+        .unwrap_or_else(|| verti_sim::vehicles::default_for_scale(scale).to_string());
     let vehicle = load_vehicle(&vehicle_name)?;
     if let Some(w) = verti_bench::identity::scale_mismatch(&vehicle, scale) {
         eprintln!("warning: {w}");

@@ -15,6 +15,18 @@ const BUILTINS: &[(&str, &str)] = &[
 ];
 
 /// Names of the built-in vehicles.
+/// The built-in vehicle a world of `scale` is driven by unless another is named: the artcar at
+/// 1/6, the verti4 at 1/10, the HMMWV otherwise (the command line and Python agree on it).
+pub fn default_for_scale(scale: f64) -> &'static str {
+    if (scale - 1.0 / 6.0).abs() < 1e-3 {
+        "artcar"
+    } else if (scale - 0.1).abs() < 1e-3 {
+        "verti4"
+    } else {
+        "hmmwv"
+    }
+}
+
 pub fn builtin_names() -> Vec<&'static str> {
     BUILTINS.iter().map(|(n, _)| *n).collect()
 }

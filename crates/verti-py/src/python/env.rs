@@ -89,7 +89,7 @@ pub(super) fn reward_arg(v: &Bound<'_, PyAny>) -> PyResult<RewardConfig> {
 pub(super) fn env_core(
     py: Python<'_>,
     worlds: &Bound<'_, PyAny>,
-    vehicle: &str,
+    vehicle: Option<&str>,
     settings: &Bound<'_, PyDict>,
 ) -> PyResult<EnvCore> {
     const KNOWN: [&str; 18] = [
@@ -130,9 +130,22 @@ pub(super) fn env_core(
                 .map_err(|_| PyTypeError::new_err(format!("{k} must be a number")))
         })
     };
-    let scale = f("scale", 1.0)?;
+    let scale = get("scale")?
+        .map(|v| {
+            v.extract::<f64>()
+                .map_err(|_| PyTypeError::new_err("scale must be a number"))
+        })
+        .transpose()?;
     let (worlds, _) = worlds_arg(py, worlds, scale)?;
-    let spec = vehicle_spec(vehicle)?;
+    // the worlds' scale picks the default vehicle; another scale's vehicle gets a warning
+    let scale = worlds[0].meta.scale;
+    let spec =
+        vehicle_spec(vehicle.unwrap_or_else(|| verti_sim::vehicles::default_for_scale(scale)))?;
+    if let Some(m) = verti_bench::identity::scale_mismatch(&spec, scale) {
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        let text = std::ffi::CString::new(m.replace('\0', " ")).expect("no NUL left");
+        PyErr::warn(py, &category, &text, 1)?;
+    }
     let mut cfg = EnvConfig::default();
     cfg.control_rate = f("control_rate", cfg.control_rate)?;
     cfg.max_speed = f("max_speed", cfg.max_speed)?;
@@ -283,11 +296,11 @@ pub struct PyEnvCore {
 #[pymethods]
 impl PyEnvCore {
     #[new]
-    #[pyo3(signature = (worlds, vehicle = "hmmwv", **settings))]
+    #[pyo3(signature = (worlds, vehicle = None, **settings))]
     fn new(
         py: Python<'_>,
         worlds: &Bound<'_, PyAny>,
-        vehicle: &str,
+        vehicle: Option<&str>,
         settings: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<PyEnvCore> {
         let empty = PyDict::new(py);
@@ -577,12 +590,12 @@ impl PyVecEnvCore {
 #[pymethods]
 impl PyVecEnvCore {
     #[new]
-    #[pyo3(signature = (num_envs, worlds, vehicle = "hmmwv", num_threads = None, **settings))]
+    #[pyo3(signature = (num_envs, worlds, vehicle = None, num_threads = None, **settings))]
     fn new(
         py: Python<'_>,
         num_envs: usize,
         worlds: &Bound<'_, PyAny>,
-        vehicle: &str,
+        vehicle: Option<&str>,
         num_threads: Option<usize>,
         settings: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<PyVecEnvCore> {

@@ -178,7 +178,7 @@ pub(super) fn params_arg(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String
 /// (default `pid`) or a Python object with `reset(task)` and `act(obs)` (see `pysystem`), which
 /// runs one trial at a time through the same trial code.
 #[pyfunction]
-#[pyo3(signature = (system = None, worlds = None, tasks = None, jobs = None, *, vehicle = "hmmwv", params = None, rules = "paper", max_time = 60.0, seed = 0, scale = 1.0, out = None, resume = false, force = false))]
+#[pyo3(signature = (system = None, worlds = None, tasks = None, jobs = None, *, vehicle = None, params = None, rules = "paper", max_time = 60.0, seed = 0, scale = None, start = "settled", out = None, resume = false, force = false))]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn evaluate(
     py: Python<'_>,
@@ -186,12 +186,13 @@ pub(super) fn evaluate(
     worlds: Option<&Bound<'_, PyAny>>,
     tasks: Option<&Bound<'_, PyAny>>,
     jobs: Option<usize>,
-    vehicle: &str,
+    vehicle: Option<&str>,
     params: Option<&Bound<'_, PyAny>>,
     rules: &str,
     max_time: f64,
     seed: u64,
-    scale: f64,
+    scale: Option<f64>,
+    start: &str,
     out: Option<PathBuf>,
     resume: bool,
     force: bool,
@@ -219,6 +220,7 @@ pub(super) fn evaluate(
         max_time,
         seed,
         scale,
+        start,
         out,
         resume,
         force,
@@ -356,11 +358,12 @@ pub(super) struct EvalArgs<'a, 'py> {
     worlds: Option<&'a Bound<'py, PyAny>>,
     tasks: Option<&'a Bound<'py, PyAny>>,
     jobs: Option<usize>,
-    vehicle: &'a str,
+    vehicle: Option<&'a str>,
     rules: &'a str,
     max_time: f64,
     seed: u64,
-    scale: f64,
+    scale: Option<f64>,
+    start: &'a str,
     out: Option<PathBuf>,
     resume: bool,
     force: bool,
@@ -377,16 +380,34 @@ struct Prepared {
 }
 
 fn prepare(py: Python<'_>, a: &EvalArgs<'_, '_>) -> PyResult<Prepared> {
-    let spec = vehicle_spec(a.vehicle)?;
     let (worlds, worlds_name) = match a.worlds {
         Some(w) if !w.is_none() => worlds_arg(py, w, a.scale)?,
         _ => worlds_arg(py, PyString::new(py, "verti-100").as_any(), a.scale)?,
     };
+    // as on the command line: the worlds' scale picks the default vehicle, and a vehicle
+    // built for another scale runs with a warning
+    let scale = worlds[0].meta.scale;
+    let spec = vehicle_spec(
+        a.vehicle
+            .unwrap_or_else(|| verti_sim::vehicles::default_for_scale(scale)),
+    )?;
+    if let Some(m) = verti_bench::identity::scale_mismatch(&spec, scale) {
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        let text = std::ffi::CString::new(m.replace('\0', " ")).expect("no NUL left");
+        PyErr::warn(py, &category, &text, 1)?;
+    }
     let selection = tasks_arg(a.tasks)?;
+    let start = verti_bench::StartMode::from_name(a.start).ok_or_else(|| {
+        value_err(format!(
+            "unknown start {:?}: use 'settled' or 'drop'",
+            a.start
+        ))
+    })?;
     let episode = EpisodeConfig {
         rules: parse_rules(a.rules)?,
         max_time: a.max_time,
         seed: a.seed,
+        start,
         ..Default::default()
     };
     episode.validate().map_err(value_err)?;

@@ -104,12 +104,16 @@ impl PyWorld {
 
     /// A world by the command line's names: `verti-100:42`, `verti-20-s7:3`, a world directory,
     /// or `DIR:INDEX` of a saved set or a Verti-Bench folder.
+    /// `scale` (default 1) applies to generated and imported worlds; a saved world keeps its
+    /// own, and another `scale` for it is an error.
     #[staticmethod]
-    #[pyo3(signature = (spec, scale = 1.0))]
-    fn resolve(py: Python<'_>, spec: String, scale: f64) -> PyResult<PyWorld> {
+    #[pyo3(signature = (spec, scale = None))]
+    fn resolve(py: Python<'_>, spec: String, scale: Option<f64>) -> PyResult<PyWorld> {
         let cancel = AtomicBool::new(false);
         let w = interruptible(py, &cancel, || {
-            verti_world::sets::resolve_world(&spec, scale)
+            let w = verti_world::sets::resolve_world(&spec, scale.unwrap_or(1.0))?;
+            verti_world::scale::set_scale(&spec, [&w], scale)?;
+            Ok(w)
         })?
         .map_err(world_err)?;
         Ok(PyWorld { inner: Arc::new(w) })
@@ -451,8 +455,17 @@ pub(super) fn image_to_numpy(
 /// Every world of a set given by name (`verti-100`, `verti-20-s7`, a saved set directory, a
 /// world directory or a folder of Verti-Bench worlds). Ctrl-C stops generation.
 #[pyfunction]
-#[pyo3(signature = (spec = "verti-100".to_string(), scale = 1.0))]
-pub(super) fn load_worlds(py: Python<'_>, spec: String, scale: f64) -> PyResult<Vec<PyWorld>> {
+#[pyo3(signature = (spec = "verti-100".to_string(), scale = None))]
+pub(super) fn load_worlds(
+    py: Python<'_>,
+    spec: String,
+    scale: Option<f64>,
+) -> PyResult<Vec<PyWorld>> {
+    if let Some(s) = scale {
+        verti_world::scale::check_scale(s).map_err(world_err)?;
+    }
+    let requested = scale;
+    let scale = scale.unwrap_or(1.0);
     if let Some(config) = verti_world::sets::builtin_config(&spec, scale)
         && !std::path::Path::new(&spec).exists()
     {
@@ -461,7 +474,10 @@ pub(super) fn load_worlds(py: Python<'_>, spec: String, scale: f64) -> PyResult<
     }
     let cancel = AtomicBool::new(false);
     let set = interruptible(py, &cancel, || {
-        verti_world::sets::resolve_set(&spec, scale, &|| {})
+        let set = verti_world::sets::resolve_set(&spec, scale, &|| {})?;
+        // a saved set keeps its scale: another one asked for is an error, not ignored
+        verti_world::scale::set_scale(&spec, &set.worlds, requested)?;
+        Ok(set)
     })?
     .map_err(world_err)?;
     Ok(set
@@ -473,10 +489,12 @@ pub(super) fn load_worlds(py: Python<'_>, spec: String, scale: f64) -> PyResult<
 
 /// Worlds from a Python argument: a World, a list of Worlds or a name (see `load_worlds`;
 /// `SET:INDEX` names one world).
+/// `scale` (default 1) applies to generated and imported worlds; worlds already built keep
+/// theirs, and another `scale` for them is an error, as is a list mixing scales.
 pub(super) fn worlds_arg(
     py: Python<'_>,
     arg: &Bound<'_, PyAny>,
-    scale: f64,
+    scale: Option<f64>,
 ) -> PyResult<(Vec<Arc<World>>, String)> {
     if let Ok(s) = arg.cast::<PyString>() {
         let spec: String = s.extract()?;
@@ -492,7 +510,9 @@ pub(super) fn worlds_arg(
         return Ok((worlds.into_iter().map(|w| w.inner).collect(), spec));
     }
     if let Ok(w) = arg.cast::<PyWorld>() {
-        return Ok((vec![w.get().inner.clone()], w.get().inner.meta.name.clone()));
+        let name = w.get().inner.meta.name.clone();
+        verti_world::scale::set_scale(&name, [&*w.get().inner], scale).map_err(world_err)?;
+        return Ok((vec![w.get().inner.clone()], name));
     }
     let mut out = Vec::new();
     let iter = arg.try_iter().map_err(|_| {
@@ -521,5 +541,6 @@ pub(super) fn worlds_arg(
     } else {
         format!("{} worlds", out.len())
     };
+    verti_world::scale::set_scale(&name, out.iter().map(|w| &**w), scale).map_err(world_err)?;
     Ok((out, name))
 }
