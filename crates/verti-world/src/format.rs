@@ -683,10 +683,36 @@ pub fn read_set_manifest(dir: &Path) -> Result<SetManifest> {
 pub fn load_set(dir: &Path) -> Result<(SetManifest, Vec<World>)> {
     use rayon::prelude::*;
     let m = read_set_manifest(dir)?;
+    let manifest = dir.join(SET_MANIFEST);
+    // task numbers come from world indices: a world listed twice, or two worlds sharing an
+    // index, would give two trials one number (and `world stats` would count them twice)
+    let mut listed = std::collections::HashSet::new();
+    for w in &m.worlds {
+        if !listed.insert(w.as_str()) {
+            return Err(WorldError::invalid(
+                &manifest,
+                "worlds",
+                format!("`{w}` is listed twice"),
+            ));
+        }
+    }
     let worlds = m
         .worlds
         .par_iter()
         .map(|w| load_world(&dir.join(w)))
         .collect::<Result<Vec<_>>>()?;
+    let mut by_index = std::collections::HashMap::new();
+    for (name, w) in m.worlds.iter().zip(&worlds) {
+        if let Some(first) = by_index.insert(w.meta.index, name) {
+            return Err(WorldError::invalid(
+                &manifest,
+                "worlds",
+                format!(
+                    "`{first}` and `{name}` both have index {}: their task numbers would collide",
+                    w.meta.index
+                ),
+            ));
+        }
+    }
     Ok((m, worlds))
 }

@@ -261,3 +261,42 @@ fn sixteen_bit_heightmaps_are_refused() {
     assert!(e.contains("world1.bmp") && e.contains("16-bit BMP"), "{e}");
     std::fs::remove_dir_all(d).ok();
 }
+
+#[test]
+fn a_set_may_not_hold_one_world_or_one_index_twice() {
+    let worlds = generate_set(
+        &SetConfig {
+            count: 2,
+            ..Default::default()
+        },
+        &|| {},
+    )
+    .unwrap();
+    let dir = tmp("twice");
+    save_set(&worlds, "two", Some(0), &dir, &|| {}).unwrap();
+    let manifest = dir.join("set.yaml");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    assert!(text.contains("[world-001, world-002]"), "{text}");
+    std::fs::write(
+        &manifest,
+        text.replace("[world-001, world-002]", "[world-001, world-001]"),
+    )
+    .unwrap();
+    let e = resolve_set(dir.to_str().unwrap(), 1.0, &|| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("set.yaml") && e.contains("`world-001` is listed twice"),
+        "{e}"
+    );
+    // two directories, one index
+    std::fs::write(&manifest, &text).unwrap();
+    let second = dir.join("world-002").join("world.yaml");
+    let w2 = std::fs::read_to_string(&second).unwrap();
+    assert!(w2.contains("\nindex: 2\n"), "{w2}");
+    std::fs::write(&second, w2.replace("\nindex: 2\n", "\nindex: 1\n")).unwrap();
+    let e = resolve_set(dir.to_str().unwrap(), 1.0, &|| {})
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("both have index 1"), "{e}");
+}
