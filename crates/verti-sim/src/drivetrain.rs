@@ -5,7 +5,7 @@
 //! `ChAutomaticTransmissionSimpleMap`: no torque converter, so the engine speed is tied to the
 //! driven wheels' mean speed through the gear and final-drive ratios.
 
-use crate::friction::LongTyre;
+use crate::friction::{CoulombTyre, LongTyre};
 use crate::math::soft_sign;
 use crate::model::{Model, WheelModel};
 use crate::spec::{MAX_WHEELS, PowertrainSpec, SteeringKind, VehicleSpec};
@@ -221,6 +221,96 @@ pub(crate) fn solve_spins(
         group_reaction[g] = -(drive + brake_applied) / grp.wheels.len() as f64;
     }
     group_reaction
+}
+
+/// Most passes of the stick/slide decision in [`solve_spins_coulomb`].
+const COULOMB_PASSES: usize = 6;
+
+/// The tangential result of one rigid tyre on rigid ground after the spin solve: forces along
+/// and across the wheel \[N\] and the new anchor deflections \[m\].
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct CoulombResult {
+    pub fx: f64,
+    pub fy: f64,
+    pub anchor_long: f64,
+    pub anchor_lat: f64,
+}
+
+/// [`solve_spins`] for a vehicle with rigid tyres: wheel `w` has the explicit spin torque
+/// `explicit[w]` and either a Coulomb contact `coulomb[w]` or the linearised force `long[w]`
+/// (soil, or in the air). Writes each Coulomb wheel's tangential result to `out` and returns
+/// the reaction torques.
+///
+/// A Coulomb contact's force is linear in the new spin while it sticks and constant (μ·N in
+/// the direction of the sticking force) while it slides, so each spin group's torque balance
+/// is piecewise linear and monotone in its new spin. It is solved by trying a set of sliding
+/// contacts, solving the linear system exactly (brakes included), and letting each contact
+/// whose sticking force at that spin exceeds μ·N slide, until the set no longer changes (a
+/// semismooth Newton iteration; a spinning or locked wheel takes two passes). Solving with
+/// every contact sticking and clamping afterwards would let the wheel's spin ignore the clamp:
+/// a wheel driven harder than the ground can take would never spin up.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn solve_spins_coulomb(
+    spec: &VehicleSpec,
+    model: &Model,
+    st: &mut SimState,
+    ctl: &Controls,
+    wheel_torque: f64,
+    explicit: &[f64; MAX_WHEELS],
+    long: &[LongTyre; MAX_WHEELS],
+    coulomb: &[Option<CoulombTyre>; MAX_WHEELS],
+    out: &mut [CoulombResult; MAX_WHEELS],
+    h: f64,
+) -> [f64; MAX_WHEELS] {
+    let groups = model.groups.len();
+    let mut spin0 = [0.0; MAX_WHEELS];
+    spin0[..groups].copy_from_slice(&st.group_spin[..groups]);
+    let mut sliding: [Option<f64>; MAX_WHEELS] = [None; MAX_WHEELS];
+    let mut reaction = [0.0; MAX_WHEELS];
+    // the sliding set the last solve used: the forces must be the ones the spins saw
+    let mut used = sliding;
+    for _ in 0..COULOMB_PASSES {
+        used = sliding;
+        let mut loads = SpinLoads::ZERO;
+        for (w, m) in model.wheels.iter().enumerate() {
+            let lt = match (&coulomb[w], sliding[w]) {
+                (Some(ct), Some(fx)) => ct.long_sliding(fx),
+                (Some(ct), None) => ct.long_sticking(),
+                (None, _) => long[w],
+            };
+            loads.add_wheel(m.group, explicit[w], &lt);
+        }
+        st.group_spin[..groups].copy_from_slice(&spin0[..groups]);
+        reaction = solve_spins(spec, model, st, ctl, wheel_torque, &loads, h);
+        let mut changed = false;
+        for (w, m) in model.wheels.iter().enumerate() {
+            let Some(ct) = &coulomb[w] else { continue };
+            let (fx, fy) = ct.trial(st.group_spin[m.group]);
+            let f = fx.hypot(fy);
+            let now = (f > ct.limit).then(|| ct.limit * fx / f);
+            changed |= match (sliding[w], now) {
+                (None, None) => false,
+                (Some(a), Some(b)) => (a - b).abs() > 1e-3 * ct.limit,
+                _ => true,
+            };
+            sliding[w] = now;
+        }
+        if !changed {
+            break;
+        }
+    }
+    for (w, m) in model.wheels.iter().enumerate() {
+        if let Some(ct) = &coulomb[w] {
+            let (fx, fy, ux, uy) = ct.resolve(st.group_spin[m.group], used[w]);
+            out[w] = CoulombResult {
+                fx,
+                fy,
+                anchor_long: ux,
+                anchor_lat: uy,
+            };
+        }
+    }
+    reaction
 }
 
 #[cfg(test)]

@@ -8,9 +8,13 @@
 //!   ([`LongTyre`], solved with the spin in `drivetrain`); [`relax_slip`] advances the slip
 //!   state; [`static_slip`] inverts the curve for a vehicle parked on a slope. The curve
 //!   shapes themselves are in [`crate::tyre`].
+//! * Rigid tyres on rigid ground: [`coulomb_tyre`] sets up Coulomb friction with a stick–slip
+//!   anchor ([`CoulombTyre`]); its sticking or sliding is decided with the spin in
+//!   `drivetrain::solve_spins_coulomb`. On soil a rigid tyre uses the soil shear above.
 //! * Soil: [`soil_tan_phi`] and [`soil_shear_strength`] (Mohr–Coulomb) per node.
 //! * Chassis: [`body_friction`], regularised Coulomb at each body contact point.
 
+use crate::contact::rigid::RigidContact;
 use crate::contact::{WheelContact, WheelKinematics};
 use crate::math::soft_sign;
 use crate::model::WheelModel;
@@ -298,4 +302,169 @@ pub(crate) fn static_slip(fx: f64, fy: f64, tyre: &TyreSpec) -> (f64, f64) {
     } else {
         (0.0, 0.0) // no pull (or a NaN one): no deflection
     }
+}
+
+/// Coulomb friction of a rigid tyre on rigid ground (Chrono's rigid tyre under NSC contact:
+/// the contact sticks while the force it needs is within μ·N and slides at μ·N otherwise).
+///
+/// Penalty form: a spring-damper of the contact's own stiffness k and damping c ties the tread
+/// to an anchor on the ground. Per internal step the anchor deflection u grows by the tread's
+/// velocity relative to the ground (u' = u + h·(ω·r − v_x) along the wheel, u' = u − h·v_y
+/// across), the ground pushes with k·u' + c·u̇, and where that exceeds μ·N the anchor slips so
+/// the force is μ·N in the same direction. So a braked vehicle on a slope holds with a fixed
+/// deflection (k·u = its share of m·g·sin θ, about a millimetre) and never creeps, and a
+/// sliding one feels exactly μ·N. The spring stands in for NSC's exact stick; its period is
+/// the normal contact's (`vehicles/hmmwv-rigid.yaml` derives it from the step).
+///
+/// The deflection is updated with the velocity before the force is applied (symplectic Euler,
+/// position first), and along the wheel it is implicit in the new spin rate, which the spin
+/// solve finds together with the stick/slide decision.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct CoulombTyre {
+    /// Contact axes: along the wheel (forward for a wheel rolling forward) and across it.
+    pub e_long: Vec3,
+    pub e_lat: Vec3,
+    /// Contact point relative to the hub \[m\].
+    pub arm: Vec3,
+    /// Lever of the longitudinal force about the axle \[m\].
+    pub radius: f64,
+    pub stiffness: f64,
+    pub damping: f64,
+    /// Velocity of the contact point (hub and chassis rotation, no spin) along the axes \[m/s\].
+    pub vx: f64,
+    pub vy: f64,
+    /// Anchor deflection at the start of the step \[m\].
+    pub anchor_long: f64,
+    pub anchor_lat: f64,
+    /// μ·N \[N\].
+    pub limit: f64,
+    pub h: f64,
+}
+
+impl CoulombTyre {
+    /// The sticking forces (along, across) at spin rate `spin`.
+    #[inline]
+    pub fn trial(&self, spin: f64) -> (f64, f64) {
+        let slip_x = spin * self.radius - self.vx;
+        let fx = self.stiffness * (self.anchor_long + self.h * slip_x) + self.damping * slip_x;
+        let fy = self.stiffness * (self.anchor_lat - self.h * self.vy) - self.damping * self.vy;
+        (fx, fy)
+    }
+
+    /// The longitudinal force as the spin solve wants it while sticking: linear in the new
+    /// spin, exactly [`CoulombTyre::trial`]'s first value.
+    #[inline]
+    pub fn long_sticking(&self) -> LongTyre {
+        LongTyre {
+            active: true,
+            e_long: self.e_long,
+            stiffness: self.stiffness,
+            a: self.anchor_long - self.h * self.vx,
+            b: self.h * self.radius,
+            decay: 1.0,
+            damping: self.damping,
+            vx: self.vx,
+            radius: self.radius,
+            limit: self.limit,
+        }
+    }
+
+    /// The longitudinal force while sliding: the constant `fx`.
+    #[inline]
+    pub fn long_sliding(&self, fx: f64) -> LongTyre {
+        LongTyre {
+            active: true,
+            e_long: self.e_long,
+            stiffness: fx,
+            a: 1.0,
+            b: 0.0,
+            decay: 1.0,
+            damping: 0.0,
+            vx: 0.0,
+            radius: self.radius,
+            limit: self.limit,
+        }
+    }
+
+    /// Final forces (along, across) and anchor deflections at spin rate `spin`; `sliding`:
+    /// the longitudinal force the spin solve used for a sliding contact.
+    #[inline]
+    pub fn resolve(&self, spin: f64, sliding: Option<f64>) -> (f64, f64, f64, f64) {
+        let (fx, fy) = self.trial(spin);
+        let f = fx.hypot(fy);
+        match sliding {
+            None if f <= self.limit => {
+                let slip_x = spin * self.radius - self.vx;
+                (
+                    fx,
+                    fy,
+                    self.anchor_long + self.h * slip_x,
+                    self.anchor_lat - self.h * self.vy,
+                )
+            }
+            _ => {
+                // sliding: the solve's longitudinal force, the rest of μ·N across, and the
+                // anchor slipped to where its spring alone carries that force
+                let fx = sliding.unwrap_or(self.limit * fx / f);
+                let rest = (self.limit * self.limit - fx * fx).max(0.0).sqrt();
+                let fy = if f > 0.0 {
+                    (self.limit * fy / f).clamp(-rest, rest)
+                } else {
+                    0.0
+                };
+                (fx, fy, fx / self.stiffness, fy / self.stiffness)
+            }
+        }
+    }
+}
+
+/// Sets up the Coulomb friction of a rigid tyre whose rigid contact carries more load than the
+/// soil under it. Returns the wheel's [`TyreForces`] before the spin solve (the tangential
+/// forces come after it, see [`CoulombTyre`]) and the contact's friction state.
+#[inline]
+pub(crate) fn coulomb_tyre(
+    tyre: &TyreSpec,
+    ws: &WheelState,
+    contact: &WheelContact,
+    rigid: &RigidContact,
+    kin: &WheelKinematics,
+    h: f64,
+) -> (TyreForces, CoulombTyre) {
+    let axle = kin.axle;
+    let n = contact.force.normalized();
+    let t = axle.cross(n);
+    // a push along the axle alone (the wheel's side against a rock): the wheel's forward axis
+    let e_long = if t.norm_sq() > 1e-12 {
+        t.normalized()
+    } else {
+        axle.cross(kin.up).normalized()
+    };
+    let e_lat = n.cross(e_long);
+    let arm = rigid.arm;
+    // the tread at `arm` moves at spin·(axle × arm); its part along e_long is −spin·radius
+    let radius = -axle.cross(arm).dot(e_long);
+    let v = kin.hub_velocity + kin.chassis_omega.cross(arm);
+    let ct = CoulombTyre {
+        e_long,
+        e_lat,
+        arm,
+        radius,
+        stiffness: tyre.radial_stiffness,
+        damping: tyre.radial_damping,
+        vx: v.dot(e_long),
+        vy: v.dot(e_lat),
+        anchor_long: ws.anchor_long,
+        anchor_lat: ws.anchor_lat,
+        limit: rigid.friction_limit,
+        h,
+    };
+    let roll =
+        -tyre.rolling_resistance * contact.rigid_load * radius * soft_sign(kin.spin * radius / 0.1);
+    let forces = TyreForces {
+        normal_load: contact.normal_load(),
+        roll_torque: roll,
+        long: ct.long_sticking(),
+        ..Default::default()
+    };
+    (forces, ct)
 }

@@ -18,15 +18,16 @@
 //! the wheels before it left in the same step.
 
 use crate::contact::body::body_contacts;
+use crate::contact::rigid::{RigidContact, rigid_wheel_contact};
 use crate::contact::wheel::wheel_contact;
 use crate::contact::{WheelContact, WheelKinematics};
-use crate::drivetrain::{self, SpinLoads};
+use crate::drivetrain::{self, CoulombResult, SpinLoads};
 use crate::error::SimError;
-use crate::friction::{self, TyreForces};
+use crate::friction::{self, CoulombTyre, LongTyre, TyreForces};
 use crate::integrate::{self, Loads};
 use crate::model::{GRAVITY, WheelModel};
 use crate::sim::Sim;
-use crate::spec::MAX_WHEELS;
+use crate::spec::{MAX_WHEELS, TyreModel};
 use crate::state::{ContactInfo, Controls, SimState, WheelState};
 use crate::suspension::{self, AxisLoad, spring_force};
 use verti_core::{Quat, Vec3};
@@ -83,23 +84,51 @@ impl Sim {
         let mut axles = [Vec3::ZERO; MAX_WHEELS];
         let mut tyres = [TyreForces::default(); MAX_WHEELS];
         let near = terrain.obstacles.near(st.position.x, st.position.y);
+        // Rigid tyres: per wheel the Coulomb contact (on rigid ground), or the linearised
+        // force (soil), with the explicit spin torque, for the stick/slide spin solve.
+        let rigid = spec.tyre.model == TyreModel::Rigid;
+        let mut coulomb: [Option<CoulombTyre>; MAX_WHEELS] = [None; MAX_WHEELS];
+        let mut longs = [LongTyre::default(); MAX_WHEELS];
+        let mut explicit = [0.0; MAX_WHEELS];
         for (w, m) in model.wheels.iter().enumerate() {
             let ws = st.wheels[w];
             let kin = frame.wheel(st, m, &ws, turn_radius);
             let soil_b = ws.soil_patch_b;
-            let contact = wheel_contact(terrain, &mut st.soil, &spec.tyre, m, soil_b, &kin, near);
+            let (contact, rigid_contact) = if rigid {
+                rigid_wheel_contact(terrain, &mut st.soil, &spec.tyre, m, soil_b, &kin, near)
+            } else {
+                let c = wheel_contact(terrain, &mut st.soil, &spec.tyre, m, soil_b, &kin, near);
+                (c, RigidContact::default())
+            };
             let spring = spring_force(m, &ws);
-            let tyre = friction::tyre_forces(&spec.tyre, spec.scale, m, &ws, &contact, &kin, h);
+            let tyre =
+                if rigid && contact.rigid_load > 0.0 && contact.rigid_load >= contact.soil_load {
+                    let (t, ct) =
+                        friction::coulomb_tyre(&spec.tyre, &ws, &contact, &rigid_contact, &kin, h);
+                    coulomb[w] = Some(ct);
+                    t
+                } else {
+                    friction::tyre_forces(&spec.tyre, spec.scale, m, &ws, &contact, &kin, h)
+                };
 
             // the spin gets rolling resistance and the soil pressure moment about the axle,
             // the composite body everything else
             let axle_moment = contact.soil_moment.dot(kin.axle);
-            spin_loads.add_wheel(m.group, tyre.roll_torque + axle_moment, &tyre.long);
+            if rigid {
+                explicit[w] = tyre.roll_torque + axle_moment;
+                longs[w] = tyre.long;
+            } else {
+                spin_loads.add_wheel(m.group, tyre.roll_torque + axle_moment, &tyre.long);
+            }
             let mut f_ext = gravity * m.unsprung_mass + contact.force;
             if tyre.long.active {
                 f_ext += tyre.lat_force;
             }
-            let soil_off_axle = contact.soil_moment - kin.axle * axle_moment;
+            let mut soil_off_axle = contact.soil_moment - kin.axle * axle_moment;
+            if rigid {
+                // the rigid contacts' camber moment (the Coulomb forces' comes after the spins)
+                soil_off_axle += rigid_contact.moment;
+            }
             let moments = (soil_off_axle, tyre.contact_moment);
             let f_axis = loads.add_wheel(kin.arm, frame.up, f_ext, spring.force, moments);
 
@@ -111,8 +140,37 @@ impl Sim {
 
         // ---- spin groups: drive, brakes (exact Coulomb), skid steering; then the
         // longitudinal tyre forces at the new spins and the drive reactions ----
-        let reaction = drivetrain::solve_spins(spec, model, st, ctl, wheel_torque, &spin_loads, h);
+        let mut coulomb_out = [CoulombResult::default(); MAX_WHEELS];
+        let reaction = if rigid {
+            drivetrain::solve_spins_coulomb(
+                spec,
+                model,
+                st,
+                ctl,
+                wheel_torque,
+                &explicit,
+                &longs,
+                &coulomb,
+                &mut coulomb_out,
+                h,
+            )
+        } else {
+            drivetrain::solve_spins(spec, model, st, ctl, wheel_torque, &spin_loads, h)
+        };
         for (w, m) in model.wheels.iter().enumerate() {
+            if let Some(ct) = &coulomb[w] {
+                // Coulomb contact: both tangential forces act at the contact point; their
+                // moment about the axle drove the spin, the rest reaches the chassis.
+                let r = &coulomb_out[w];
+                let f = ct.e_long * r.fx + ct.e_lat * r.fy;
+                let f_axis = loads.add_wheel_force(axis_loads[w].arm, frame.up, f);
+                axis_loads[w].external += f_axis;
+                let moment = ct.arm.cross(f);
+                loads.torque += moment - axles[w] * moment.dot(axles[w]);
+                st.wheels[w].long_force = r.fx;
+                st.wheels[w].lat_force = r.fy;
+                continue;
+            }
             let long = &tyres[w].long;
             if !long.active {
                 st.wheels[w].long_force = 0.0;
@@ -139,8 +197,27 @@ impl Sim {
         for ((ws, m), load) in st.wheels.iter_mut().zip(&model.wheels).zip(&axis_loads) {
             suspension::update_wheel(ws, m, load, &acc, v, frame.omega, frame.up, h);
         }
-        for (ws, tyre) in st.wheels.iter_mut().zip(&tyres) {
-            friction::relax_slip(ws, tyre, &spec.tyre, h);
+        if rigid {
+            for (w, ws) in st.wheels.iter_mut().enumerate() {
+                // the anchor lives while the contact is Coulomb; soil and air forget it
+                let r = if coulomb[w].is_some() {
+                    coulomb_out[w]
+                } else {
+                    CoulombResult::default()
+                };
+                ws.anchor_long = r.anchor_long;
+                ws.anchor_lat = r.anchor_lat;
+                if coulomb[w].is_some() {
+                    ws.slip_long = 0.0;
+                    ws.slip_lat = 0.0;
+                } else {
+                    friction::relax_slip(ws, &tyres[w], &spec.tyre, h);
+                }
+            }
+        } else {
+            for (ws, tyre) in st.wheels.iter_mut().zip(&tyres) {
+                friction::relax_slip(ws, tyre, &spec.tyre, h);
+            }
         }
         integrate::advance_chassis(model, st, &loads, &acc, h);
         st.contacts = contacts;
