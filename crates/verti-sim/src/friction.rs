@@ -133,7 +133,9 @@ pub(crate) struct TyreForces {
 
 /// Tyre (rigid ground) or traction (soil) forces of one wheel from its transient slip. The
 /// lateral force is final; the longitudinal one is returned linearised in the new spin.
-#[inline]
+/// (Always inlined: called from the handling and the rigid tyres' stages, it would otherwise
+/// become a call with its large result copied, a few per cent of a step.)
+#[inline(always)]
 pub(crate) fn tyre_forces(
     tyre: &TyreSpec,
     vehicle_scale: f64,
@@ -254,7 +256,7 @@ pub(crate) fn tyre_forces(
 /// exactly the value the spin solve used (κ = a + b·ω); laterally it relaxes with the same
 /// decay. Either is clamped where the curve reaches its sliding plateau, so the state never
 /// winds up; a tyre in the air relaxes its deflection at once.
-#[inline]
+#[inline(always)]
 pub(crate) fn relax_slip(ws: &mut WheelState, tyre_forces: &TyreForces, tyre: &TyreSpec, h: f64) {
     let lt = &tyre_forces.long;
     if tyre_forces.normal_load <= 0.0 || !lt.active {
@@ -317,8 +319,9 @@ pub(crate) fn static_slip(fx: f64, fy: f64, tyre: &TyreSpec) -> (f64, f64) {
 /// the normal contact's (`vehicles/hmmwv-rigid.yaml` derives it from the step).
 ///
 /// The deflection is updated with the velocity before the force is applied (symplectic Euler,
-/// position first), and along the wheel it is implicit in the new spin rate, which the spin
-/// solve finds together with the stick/slide decision.
+/// position first), and along the wheel it is implicit in the new spin rate ω, which the spin
+/// solve finds together with the stick/slide decision: while sticking the force along the
+/// wheel is `fx0 + dfx·ω`.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct CoulombTyre {
     /// Contact axes: along the wheel (forward for a wheel rolling forward) and across it.
@@ -328,62 +331,24 @@ pub(crate) struct CoulombTyre {
     pub arm: Vec3,
     /// Lever of the longitudinal force about the axle \[m\].
     pub radius: f64,
+    /// Sticking forces: along the wheel `fx0 + dfx·ω` \[N\], across it `fy` \[N\].
+    pub fx0: f64,
+    pub dfx: f64,
+    pub fy: f64,
+    /// Sticking anchor deflections: along `ux0 + dux·ω`, across `uy` \[m\].
+    pub ux0: f64,
+    pub dux: f64,
+    pub uy: f64,
     pub stiffness: f64,
-    pub damping: f64,
-    /// Velocity of the contact point (hub and chassis rotation, no spin) along the axes \[m/s\].
-    pub vx: f64,
-    pub vy: f64,
-    /// Anchor deflection at the start of the step \[m\].
-    pub anchor_long: f64,
-    pub anchor_lat: f64,
     /// μ·N \[N\].
     pub limit: f64,
-    pub h: f64,
 }
 
 impl CoulombTyre {
     /// The sticking forces (along, across) at spin rate `spin`.
     #[inline]
     pub fn trial(&self, spin: f64) -> (f64, f64) {
-        let slip_x = spin * self.radius - self.vx;
-        let fx = self.stiffness * (self.anchor_long + self.h * slip_x) + self.damping * slip_x;
-        let fy = self.stiffness * (self.anchor_lat - self.h * self.vy) - self.damping * self.vy;
-        (fx, fy)
-    }
-
-    /// The longitudinal force as the spin solve wants it while sticking: linear in the new
-    /// spin, exactly [`CoulombTyre::trial`]'s first value.
-    #[inline]
-    pub fn long_sticking(&self) -> LongTyre {
-        LongTyre {
-            active: true,
-            e_long: self.e_long,
-            stiffness: self.stiffness,
-            a: self.anchor_long - self.h * self.vx,
-            b: self.h * self.radius,
-            decay: 1.0,
-            damping: self.damping,
-            vx: self.vx,
-            radius: self.radius,
-            limit: self.limit,
-        }
-    }
-
-    /// The longitudinal force while sliding: the constant `fx`.
-    #[inline]
-    pub fn long_sliding(&self, fx: f64) -> LongTyre {
-        LongTyre {
-            active: true,
-            e_long: self.e_long,
-            stiffness: fx,
-            a: 1.0,
-            b: 0.0,
-            decay: 1.0,
-            damping: 0.0,
-            vx: 0.0,
-            radius: self.radius,
-            limit: self.limit,
-        }
+        (self.fx0 + self.dfx * spin, self.fy)
     }
 
     /// Final forces (along, across) and anchor deflections at spin rate `spin`; `sliding`:
@@ -391,17 +356,9 @@ impl CoulombTyre {
     #[inline]
     pub fn resolve(&self, spin: f64, sliding: Option<f64>) -> (f64, f64, f64, f64) {
         let (fx, fy) = self.trial(spin);
-        let f = fx.hypot(fy);
+        let f = (fx * fx + fy * fy).sqrt();
         match sliding {
-            None if f <= self.limit => {
-                let slip_x = spin * self.radius - self.vx;
-                (
-                    fx,
-                    fy,
-                    self.anchor_long + self.h * slip_x,
-                    self.anchor_lat - self.h * self.vy,
-                )
-            }
+            None if f <= self.limit => (fx, fy, self.ux0 + self.dux * spin, self.uy),
             _ => {
                 // sliding: the solve's longitudinal force, the rest of μ·N across, and the
                 // anchor slipped to where its spring alone carries that force
@@ -419,8 +376,8 @@ impl CoulombTyre {
 }
 
 /// Sets up the Coulomb friction of a rigid tyre whose rigid contact carries more load than the
-/// soil under it. Returns the wheel's [`TyreForces`] before the spin solve (the tangential
-/// forces come after it, see [`CoulombTyre`]) and the contact's friction state.
+/// soil under it. Returns the rolling-resistance torque on the spin and the contact's
+/// friction state (the tangential forces come after the spin solve, see [`CoulombTyre`]).
 #[inline]
 pub(crate) fn coulomb_tyre(
     tyre: &TyreSpec,
@@ -429,7 +386,7 @@ pub(crate) fn coulomb_tyre(
     rigid: &RigidContact,
     kin: &WheelKinematics,
     h: f64,
-) -> (TyreForces, CoulombTyre) {
+) -> (f64, CoulombTyre) {
     let axle = kin.axle;
     let n = contact.force.normalized();
     let t = axle.cross(n);
@@ -444,27 +401,28 @@ pub(crate) fn coulomb_tyre(
     // the tread at `arm` moves at spin·(axle × arm); its part along e_long is −spin·radius
     let radius = -axle.cross(arm).dot(e_long);
     let v = kin.hub_velocity + kin.chassis_omega.cross(arm);
+    let (vx, vy) = (v.dot(e_long), v.dot(e_lat));
+    let (k, c) = (tyre.radial_stiffness, tyre.radial_damping);
+    // anchors after the step: u' = u + h·(ω·r − v_x) along, u − h·v_y across
+    let (ux0, dux, uy) = (ws.anchor_long - h * vx, h * radius, ws.anchor_lat - h * vy);
     let ct = CoulombTyre {
         e_long,
         e_lat,
         arm,
         radius,
-        stiffness: tyre.radial_stiffness,
-        damping: tyre.radial_damping,
-        vx: v.dot(e_long),
-        vy: v.dot(e_lat),
-        anchor_long: ws.anchor_long,
-        anchor_lat: ws.anchor_lat,
+        fx0: k * ux0 - c * vx,
+        dfx: radius * (k * h + c),
+        fy: k * uy - c * vy,
+        ux0,
+        dux,
+        uy,
+        stiffness: k,
         limit: rigid.friction_limit,
-        h,
     };
-    let roll =
-        -tyre.rolling_resistance * contact.rigid_load * radius * soft_sign(kin.spin * radius / 0.1);
-    let forces = TyreForces {
-        normal_load: contact.normal_load(),
-        roll_torque: roll,
-        long: ct.long_sticking(),
-        ..Default::default()
+    let roll = if tyre.rolling_resistance > 0.0 {
+        -tyre.rolling_resistance * contact.rigid_load * radius * soft_sign(kin.spin * radius / 0.1)
+    } else {
+        0.0
     };
-    (forces, ct)
+    (roll, ct)
 }

@@ -48,6 +48,7 @@ pub mod spec;
 mod start;
 mod state;
 mod step;
+mod step_rigid;
 mod suspension;
 mod terrain;
 pub mod testing;

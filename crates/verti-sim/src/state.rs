@@ -101,6 +101,10 @@ pub struct WheelState {
     pub anchor_long: f64,
     #[serde(default)]
     pub anchor_lat: f64,
+    /// Rigid tyre on rigid ground: the contact slid (friction at μ·N) in the last internal
+    /// step. The next step's stick/slide decision starts from it.
+    #[serde(default)]
+    pub sliding: bool,
     // ---- outputs of the last internal step ----
     /// Road-wheel steer angle \[rad\].
     pub steer_angle: f64,

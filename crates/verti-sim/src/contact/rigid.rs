@@ -7,12 +7,13 @@
 //! them from the internal step, see `vehicles/hmmwv-rigid.yaml`).
 //!
 //! Where the cylinder meets things:
-//! * **Terrain** (the heightfield's triangles): on each of the two edge circles of the tread,
-//!   the point deepest toward the ground under the hub plus points 30° and 60° on either side
-//!   of it along the circle. On a plane only the deepest points touch; where the ground
-//!   rises ahead (a bank, a ditch's far side) the forward points meet it with its own normal.
-//!   The two circles carry half the stiffness each: a line contact across the tread, exact for
-//!   any tilt of the ground across the wheel.
+//! * **Terrain** (the heightfield's triangles): along the tread's centre circle, the point
+//!   deepest toward the ground (found from one sample below the hub and the ground's plane
+//!   there) plus points 30° and 60° on either side of it. On a plane only the deepest point
+//!   touches; where the ground rises ahead (a bank, a ditch's far side) the forward points
+//!   meet it with its own normal. At each point the two edges of the tread meet the ground's
+//!   local plane and carry half the stiffness each: a line contact across the tread, exact
+//!   for any tilt of the ground across the wheel.
 //! * **Rocks** (convex polytopes): the rock is cut by the planes of three circles across the
 //!   tread (edges and centre, weights ¼ ½ ¼, the trapezoid rule over the width) and each
 //!   circle meets its cut polygon exactly: the penetration is the radius minus the distance
@@ -37,7 +38,7 @@ use crate::spec::TyreSpec;
 use crate::terrain::{FastObstacle, Terrain};
 use verti_core::Vec3;
 
-/// (cos, sin) of the terrain samples' angles from the deepest point along each edge circle.
+/// (cos, sin) of the terrain samples' angles from the deepest point along the tread's circle.
 const ARC: [(f64, f64); 5] = [
     (1.0, 0.0),
     (0.866_025_403_784_438_6, 0.5),
@@ -89,6 +90,36 @@ impl Sum<'_> {
         if f <= 0.0 {
             return; // separating faster than the spring pushes: a contact never pulls
         }
+        self.sum(w, f, arm * f, depth * depth * w, n, mu);
+    }
+
+    /// Two contacts of weight ½ with one normal `n`: the tread's edges at `arm ± offset`,
+    /// `depth ± tilt` deep (the pair [`Sum::add`] would make, summed once).
+    #[inline]
+    fn add_edges(&mut self, arm: Vec3, offset: Vec3, depth: f64, tilt: f64, n: Vec3, mu: f64) {
+        let rate = -self.v_hub.dot(n);
+        let edge = |d: f64| {
+            let f = 0.5 * (self.k * d + self.damping * rate);
+            if d > 0.0 && f > 0.0 {
+                (f, 0.5)
+            } else {
+                (0.0, 0.0)
+            }
+        };
+        let (da, db) = (depth + tilt, depth - tilt);
+        let ((fa, wa), (fb, wb)) = (edge(da), edge(db));
+        let f = fa + fb;
+        if f <= 0.0 {
+            return;
+        }
+        let sq = wa * da * da + wb * db * db;
+        self.sum(wa + wb, f, arm * f + offset * (fa - fb), sq, n, mu);
+    }
+
+    /// Adds contacts of total weight `w` and force `f` along `n`, whose force-weighted arms
+    /// sum to `moment_arm` and whose weighted squared depths sum to `sq`.
+    #[inline]
+    fn sum(&mut self, w: f64, f: f64, moment_arm: Vec3, sq: f64, n: Vec3, mu: f64) {
         let (kw, cw) = (w * self.k, w * self.damping);
         let nu = n.dot(self.up);
         let c = &mut *self.c;
@@ -97,15 +128,15 @@ impl Sum<'_> {
         c.c_axis += cw * nu * nu;
         c.k_vec += n * (kw * nu);
         c.c_vec += n * (cw * nu);
+        // (the friction limit below replaces the handling tyre's load-weighted `mu_scale`)
         let mu = mu.min(self.tyre_mu);
-        c.mu_scale = (c.mu_scale * c.rigid_load + mu / self.tyre_mu * f) / (c.rigid_load + f);
         c.rigid_load += f;
         let rc = &mut *self.rc;
         rc.friction_limit += mu * f;
-        rc.arm += arm * f;
-        let moment = arm.cross(n * f);
+        rc.arm += moment_arm;
+        let moment = moment_arm.cross(n);
         rc.moment += moment - self.axle * moment.dot(self.axle);
-        self.depth_sq += w * depth * depth;
+        self.depth_sq += sq;
     }
 }
 
@@ -156,54 +187,82 @@ pub(crate) fn rigid_wheel_contact(
             d / d.norm().max(1e-12)
         }
     };
-    let lowest_z = hub.z + r * down.z - hw * axle.z.abs();
-    let ground_max = terrain
-        .bound
-        .max_in(hub.x - r, hub.y - r, hub.x + r, hub.y + r);
     let soil_rigid = soil_as_rigid(terrain, m);
     let mut soil_here = false;
-    if lowest_z < ground_max {
-        // The deepest direction toward the ground plane under the hub, within the wheel's
-        // plane; the samples fan out from it along each edge circle.
-        let (_, gx, gy) = ground.sample(hub.x, hub.y);
-        let n0 = Vec3::new(-gx, -gy, 1.0);
-        let np = n0 - axle * n0.dot(axle);
-        let npn = np.norm();
-        let d0 = if npn > 1e-6 * n0.norm() {
-            -np / npn
+    // How far the tread's edges reach below its centre line, measured vertically.
+    let edge_drop = hw * axle.z.abs();
+    // The lowest point of the wheel in its plane toward the chassis floor, and the ground
+    // there. On a plane whose normal is that sample's, the deepest point of the tread's
+    // circle is at d0 (in the wheel's plane, against the plane's normal), deeper than the
+    // sample by R·(d·n + |n_p|): the same as sampling the ground under the hub for its normal
+    // first, for one sample less.
+    let d_up = {
+        let u = kin.up - axle * kin.up.dot(axle);
+        let n = u.norm();
+        if n > 1e-6 { -u / n } else { down }
+    };
+    let mut d0 = d_up;
+    {
+        let p = hub + d_up * r;
+        let (h, gx, gy) = ground.sample(p.x, p.y);
+        let surface = &patches[ground.patch_index(p.x, p.y)].surface;
+        // Soil the grid resolves is the soil stage's; off the map, or where the grid cannot
+        // resolve this wheel, soil is rigid ground of friction tan φ.
+        if surface.is_deformable() && !soil_rigid && hf.contains(p.x, p.y) {
+            soil_here = true;
         } else {
-            down
-        };
-        let t0 = d0.cross(axle);
-        for side in [-hw, hw] {
-            for &(ca, sa) in &ARC {
-                let arm = axle * side + (d0 * ca + t0 * sa) * r;
-                let p = hub + arm;
-                if p.z >= ground_max || p.z >= terrain.bound.max_at(p.x, p.y) {
-                    continue;
-                }
-                let (h, gx, gy) = ground.sample(p.x, p.y);
-                if h <= p.z {
-                    continue;
-                }
-                let surface = &patches[ground.patch_index(p.x, p.y)].surface;
-                // Soil the grid resolves is the soil stage's; off the map, or where the grid
-                // cannot resolve this wheel, soil is rigid ground of friction tan φ.
-                if surface.is_deformable() && !soil_rigid && hf.contains(p.x, p.y) {
-                    soil_here = true;
-                    continue;
-                }
-                let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
-                let n = Vec3::new(-gx * nz, -gy * nz, nz);
-                sum.add(0.5, arm, (h - p.z) * nz, n, surface_mu(surface));
+            let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
+            let n = Vec3::new(-gx * nz, -gy * nz, nz);
+            let np = n - axle * n.dot(axle);
+            let npn = np.norm();
+            if npn > 1e-6 {
+                d0 = -np / npn;
+            }
+            let deepest = (h - p.z) * nz + r * (d_up.dot(n) + npn);
+            // The two edges of the tread against the ground's plane (the heightfield is
+            // planar over a triangle, and the tread is a quarter of a cell wide): each
+            // carries half the stiffness, so a line contact sums to k·δ and a wheel tilted
+            // across the ground loads its lower edge (the edge at −axle·hw is deeper than the
+            // centre line by hw·(axle·n)).
+            if deepest + hw * axle.dot(n).abs() > 0.0 {
+                let tilt = hw * axle.dot(n);
+                sum.add_edges(d0 * r, -axle * hw, deepest, tilt, n, surface_mu(surface));
             }
         }
-        if !soil_here && terrain.soil.is_some() {
-            // the wheel may be sunk in soil with its samples above the undeformed level
-            soil_here = patches[ground.patch_index(hub.x, hub.y)]
-                .surface
-                .is_deformable();
+    }
+    // the fan: 30° and 60° either side of the lowest point
+    let t0 = d0.cross(axle);
+    for &(ca, sa) in &ARC[1..] {
+        let dir = d0 * ca + t0 * sa;
+        let p = hub + dir * r;
+        let low = p.z - edge_drop;
+        // most points of the fan are above the ground: probe the height first
+        if ground.height(p.x, p.y) <= low {
+            continue;
         }
+        let (h, gx, gy) = ground.sample(p.x, p.y);
+        let surface = &patches[ground.patch_index(p.x, p.y)].surface;
+        if surface.is_deformable() && !soil_rigid && hf.contains(p.x, p.y) {
+            soil_here = true;
+            continue;
+        }
+        let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
+        let n = Vec3::new(-gx * nz, -gy * nz, nz);
+        let tilt = hw * axle.dot(n);
+        sum.add_edges(
+            dir * r,
+            -axle * hw,
+            (h - p.z) * nz,
+            tilt,
+            n,
+            surface_mu(surface),
+        );
+    }
+    if !soil_here && terrain.soil.is_some() {
+        // the wheel may be sunk in soil with its samples above the undeformed level
+        soil_here = patches[ground.patch_index(hub.x, hub.y)]
+            .surface
+            .is_deformable();
     }
 
     // Obstacles. (e1, e2) = (axle × down, −down): an orthonormal basis of the wheel's plane.
