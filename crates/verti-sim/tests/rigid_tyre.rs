@@ -297,6 +297,60 @@ fn no_energy_gain_on_bumpy_ground() {
     assert!(sim.energy(&st) < e0);
 }
 
+/// Height of the total centre of mass above flat ground at rest: sprung mass at the COM,
+/// unsprung masses at the wheel centres (free-length height plus the static sag), the ground
+/// one radius less the static penetration below the wheel centres (as `validation.rs`).
+fn static_com_height(spec: &VehicleSpec) -> f64 {
+    let w = spec.chassis.mass * G;
+    let (xf, xr) = (spec.axles[0].x, spec.axles[1].x);
+    let front = 0.5 * w * (spec.chassis.com[0] - xr) / (xf - xr);
+    let rear = 0.5 * w - front;
+    let hub = |i: usize, load: f64| spec.axles[i].z + load / spec.axles[i].suspension.stiffness;
+    let (hf, hr) = (hub(0, front), hub(1, rear));
+    let mu = spec.axles[0].wheel.unsprung_mass;
+    let total = spec.total_mass();
+    let com_z = (spec.chassis.mass * spec.chassis.com[2] + 2.0 * mu * (hf + hr)) / total;
+    let penetration = 0.25 * total * G / spec.tyre.radial_stiffness;
+    com_z - (0.5 * (hf + hr) - (spec.axles[0].wheel.radius - penetration))
+}
+
+/// Largest |roll| over 4 s parked (brakes on) across a side slope of `deg` of friction 2.
+fn max_roll_on_side_slope(spec: &VehicleSpec, deg: f64) -> f64 {
+    let world = testing::plane_world(1.0, 0.0, deg.to_radians(), 2.0);
+    let (sim, mut st) = sim_at(world, spec, 0.0, 0.0, 0.0);
+    let mut worst: f64 = 0.0;
+    for _ in 0..400 {
+        sim.step(&mut st, Controls::new(0.0, 1.0, 0.0), 0.01)
+            .unwrap();
+        worst = worst.max(st.euler().0.abs());
+        if st.is_rolled_over() {
+            return std::f64::consts::PI;
+        }
+    }
+    worst
+}
+
+// 7. Tilt table (validation test 3 for the rigid tyre): a rigid vehicle tips when the resultant
+//    of gravity passes the downhill wheels, tan φ = t / (2h), h the static COM height from the
+//    file (φ ≈ 56°). With tyre and ground friction 2, so it tips before sliding: across a slope
+//    of 0.95·φ it stays upright (the body leans at most 10° beyond the slope on its springs),
+//    at 1.05·φ it rolls over.
+#[test]
+fn tilt_table_rollover_angle() {
+    let mut spec = rigid();
+    spec.tyre.friction = 2.0;
+    let h = static_com_height(&spec);
+    let phi = (spec.axles[0].track / (2.0 * h)).atan().to_degrees();
+    let below = max_roll_on_side_slope(&spec, 0.95 * phi).to_degrees();
+    let above = max_roll_on_side_slope(&spec, 1.05 * phi).to_degrees();
+    println!("φ {phi:.2}° (h {h:.4} m): max roll at 0.95φ {below:.1}°, at 1.05φ {above:.1}°");
+    assert!(
+        below < 0.95 * phi + 10.0,
+        "at 0.95 φ the roll reached {below:.1}°"
+    );
+    assert!(above > 90.0, "at 1.05 φ it did not roll over ({above:.1}°)");
+}
+
 /// Bekker's closed form for a rigid wheel of width b and radius R at rest under load W
 /// (contact arc as a parabola over both halves), as in `validation.rs`.
 fn bekker_static_sinkage(load: f64, b: f64, r: f64, soil: &SoilParams) -> f64 {
@@ -306,7 +360,7 @@ fn bekker_static_sinkage(load: f64, b: f64, r: f64, soil: &SoilParams) -> f64 {
     (load / (2.0 * b * k * (2.0 * r).sqrt() * i)).powf(1.0 / (n + 0.5))
 }
 
-// 7. On deformable soil the rigid tyre is the SCM stage's rigid cylinder: at rest on mud it
+// 8. On deformable soil the rigid tyre is the SCM stage's rigid cylinder: at rest on mud it
 //    sinks to Bekker's closed-form depth within 10 % (the set-up of validation test 5a: treads
 //    0.3 m wide spanning three soil-node columns, heavy soil damping for a quasi-static load).
 #[test]
@@ -352,7 +406,7 @@ fn random_drive(sim: &Sim, st: &mut SimState, seed: u64, steps: usize) -> Vec<u6
     trace
 }
 
-// 8. Determinism: on a rough world of rigid and soil patches with rocks, the same inputs give
+// 9. Determinism: on a rough world of rigid and soil patches with rocks, the same inputs give
 //    bit-identical trajectories, and a clone taken mid-run continues exactly like the original.
 #[test]
 fn bit_identical_trajectories_and_clones() {
