@@ -43,13 +43,13 @@ pub fn run_vehicle(cmd: VehicleCommand) -> CmdResult {
     match cmd {
         VehicleCommand::List => {
             println!(
-                "{:<8} {:>7} {:>9} {:>7} {:>6}  description",
+                "{:<11} {:>7} {:>9} {:>7} {:>6}  description",
                 "name", "scale", "mass kg", "wheels", "track"
             );
             for spec in vehicles::all_builtin() {
                 let wheels: usize = spec.axles.len() * 2;
                 println!(
-                    "{:<8} {:>7} {:>9.1} {:>7} {:>6}  {}",
+                    "{:<11} {:>7} {:>9.1} {:>7} {:>6}  {}",
                     spec.name,
                     verti_world::scale::scale_label(spec.scale),
                     spec.total_mass(),

@@ -5,7 +5,7 @@
 //! `ChAutomaticTransmissionSimpleMap`: no torque converter, so the engine speed is tied to the
 //! driven wheels' mean speed through the gear and final-drive ratios.
 
-use crate::friction::LongTyre;
+use crate::friction::{CoulombTyre, LongTyre};
 use crate::math::soft_sign;
 use crate::model::{Model, WheelModel};
 use crate::spec::{MAX_WHEELS, PowertrainSpec, SteeringKind, VehicleSpec};
@@ -221,6 +221,117 @@ pub(crate) fn solve_spins(
         group_reaction[g] = -(drive + brake_applied) / grp.wheels.len() as f64;
     }
     group_reaction
+}
+
+/// Most passes of the stick/slide decision in [`solve_spins_coulomb`].
+const COULOMB_PASSES: usize = 6;
+
+/// The tangential result of one rigid tyre on rigid ground after the spin solve: forces along
+/// and across the wheel \[N\], the new anchor deflections \[m\] and whether it slid.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct CoulombResult {
+    pub fx: f64,
+    pub fy: f64,
+    pub anchor_long: f64,
+    pub anchor_lat: f64,
+    pub sliding: bool,
+}
+
+/// [`solve_spins`] for a vehicle with rigid tyres: `base` holds every wheel's explicit spin
+/// torque and the linearised forces of the wheels without a Coulomb contact (soil, air);
+/// `coulomb[w]` is wheel `w`'s Coulomb contact on rigid ground, if it has one. Writes each
+/// Coulomb wheel's tangential result to `out` and returns the reaction torques.
+///
+/// A Coulomb contact's force is linear in the new spin while it sticks and constant (μ·N in
+/// the direction of the sticking force) while it slides, so each spin group's torque balance
+/// is piecewise linear and monotone in its new spin. It is solved by trying a set of sliding
+/// contacts, solving the linear system exactly (brakes included), and letting each contact
+/// whose sticking force at that spin exceeds μ·N slide, until the set no longer changes (a
+/// semismooth Newton iteration). Solving with every contact sticking and clamping afterwards
+/// would let the wheel's spin ignore the clamp: a wheel driven harder than the ground can
+/// take would never spin up. The first guess is the last step's set (`st.wheels[w].sliding`):
+/// the answer does not depend on it, the number of passes does (mostly one).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn solve_spins_coulomb(
+    spec: &VehicleSpec,
+    model: &Model,
+    st: &mut SimState,
+    ctl: &Controls,
+    wheel_torque: f64,
+    base: &SpinLoads,
+    coulomb: &[Option<CoulombTyre>; MAX_WHEELS],
+    out: &mut [CoulombResult; MAX_WHEELS],
+    h: f64,
+) -> [f64; MAX_WHEELS] {
+    let groups = model.groups.len();
+    let mut spin0 = [0.0; MAX_WHEELS];
+    spin0[..groups].copy_from_slice(&st.group_spin[..groups]);
+    // each Coulomb wheel's longitudinal force while it slides (NaN: it sticks)
+    let mut slide = [f64::NAN; MAX_WHEELS];
+    for (w, m) in model.wheels.iter().enumerate() {
+        if let Some(ct) = &coulomb[w]
+            && st.wheels[w].sliding
+        {
+            let (fx, fy) = ct.trial(spin0[m.group]);
+            let f = (fx * fx + fy * fy).sqrt();
+            if f > 0.0 {
+                slide[w] = ct.limit * fx / f;
+            }
+        }
+    }
+    let mut reaction = [0.0; MAX_WHEELS];
+    // the sliding forces the last solve used: the forces must be the ones the spins saw
+    let mut used = slide;
+    for _ in 0..COULOMB_PASSES {
+        let mut loads = *base;
+        for (w, m) in model.wheels.iter().enumerate() {
+            let Some(ct) = &coulomb[w] else { continue };
+            if slide[w].is_nan() {
+                // sticking: torque −r·(fx0 + dfx·ω) on the spin
+                loads.stiffness[m.group] += ct.radius * ct.dfx;
+                loads.torque[m.group] -= ct.radius * ct.fx0;
+            } else {
+                loads.torque[m.group] -= ct.radius * slide[w];
+            }
+        }
+        st.group_spin[..groups].copy_from_slice(&spin0[..groups]);
+        reaction = solve_spins(spec, model, st, ctl, wheel_torque, &loads, h);
+        let mut changed = false;
+        for (w, m) in model.wheels.iter().enumerate() {
+            let Some(ct) = &coulomb[w] else { continue };
+            let (fx, fy) = ct.trial(st.group_spin[m.group]);
+            let f = (fx * fx + fy * fy).sqrt();
+            let now = if f > ct.limit {
+                ct.limit * fx / f
+            } else {
+                f64::NAN
+            };
+            changed |= match (slide[w].is_nan(), now.is_nan()) {
+                (true, true) => false,
+                (false, false) => (slide[w] - now).abs() > 1e-3 * ct.limit,
+                _ => true,
+            };
+            used[w] = slide[w];
+            slide[w] = now;
+        }
+        if !changed {
+            break;
+        }
+    }
+    for (w, m) in model.wheels.iter().enumerate() {
+        if let Some(ct) = &coulomb[w] {
+            let sliding = (!used[w].is_nan()).then_some(used[w]);
+            let (fx, fy, ux, uy) = ct.resolve(st.group_spin[m.group], sliding);
+            out[w] = CoulombResult {
+                fx,
+                fy,
+                anchor_long: ux,
+                anchor_lat: uy,
+                sliding: sliding.is_some(),
+            };
+        }
+    }
+    reaction
 }
 
 #[cfg(test)]

@@ -8,9 +8,13 @@
 //!   ([`LongTyre`], solved with the spin in `drivetrain`); [`relax_slip`] advances the slip
 //!   state; [`static_slip`] inverts the curve for a vehicle parked on a slope. The curve
 //!   shapes themselves are in [`crate::tyre`].
+//! * Rigid tyres on rigid ground: [`coulomb_tyre`] sets up Coulomb friction with a stick–slip
+//!   anchor ([`CoulombTyre`]); its sticking or sliding is decided with the spin in
+//!   `drivetrain::solve_spins_coulomb`. On soil a rigid tyre uses the soil shear above.
 //! * Soil: [`soil_tan_phi`] and [`soil_shear_strength`] (Mohr–Coulomb) per node.
 //! * Chassis: [`body_friction`], regularised Coulomb at each body contact point.
 
+use crate::contact::rigid::RigidContact;
 use crate::contact::{WheelContact, WheelKinematics};
 use crate::math::soft_sign;
 use crate::model::WheelModel;
@@ -129,7 +133,9 @@ pub(crate) struct TyreForces {
 
 /// Tyre (rigid ground) or traction (soil) forces of one wheel from its transient slip. The
 /// lateral force is final; the longitudinal one is returned linearised in the new spin.
-#[inline]
+/// (Always inlined: called from the handling and the rigid tyres' stages, it would otherwise
+/// become a call with its large result copied, a few per cent of a step.)
+#[inline(always)]
 pub(crate) fn tyre_forces(
     tyre: &TyreSpec,
     vehicle_scale: f64,
@@ -250,7 +256,7 @@ pub(crate) fn tyre_forces(
 /// exactly the value the spin solve used (κ = a + b·ω); laterally it relaxes with the same
 /// decay. Either is clamped where the curve reaches its sliding plateau, so the state never
 /// winds up; a tyre in the air relaxes its deflection at once.
-#[inline]
+#[inline(always)]
 pub(crate) fn relax_slip(ws: &mut WheelState, tyre_forces: &TyreForces, tyre: &TyreSpec, h: f64) {
     let lt = &tyre_forces.long;
     if tyre_forces.normal_load <= 0.0 || !lt.active {
@@ -298,4 +304,125 @@ pub(crate) fn static_slip(fx: f64, fy: f64, tyre: &TyreSpec) -> (f64, f64) {
     } else {
         (0.0, 0.0) // no pull (or a NaN one): no deflection
     }
+}
+
+/// Coulomb friction of a rigid tyre on rigid ground (Chrono's rigid tyre under NSC contact:
+/// the contact sticks while the force it needs is within μ·N and slides at μ·N otherwise).
+///
+/// Penalty form: a spring-damper of the contact's own stiffness k and damping c ties the tread
+/// to an anchor on the ground. Per internal step the anchor deflection u grows by the tread's
+/// velocity relative to the ground (u' = u + h·(ω·r − v_x) along the wheel, u' = u − h·v_y
+/// across), the ground pushes with k·u' + c·u̇, and where that exceeds μ·N the anchor slips so
+/// the force is μ·N in the same direction. So a braked vehicle on a slope holds with a fixed
+/// deflection (k·u = its share of m·g·sin θ, about a millimetre) and never creeps, and a
+/// sliding one feels exactly μ·N. The spring stands in for NSC's exact stick; its period is
+/// the normal contact's (`vehicles/hmmwv-rigid.yaml` derives it from the step).
+///
+/// The deflection is updated with the velocity before the force is applied (symplectic Euler,
+/// position first), and along the wheel it is implicit in the new spin rate ω, which the spin
+/// solve finds together with the stick/slide decision: while sticking the force along the
+/// wheel is `fx0 + dfx·ω`.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct CoulombTyre {
+    /// Contact axes: along the wheel (forward for a wheel rolling forward) and across it.
+    pub e_long: Vec3,
+    pub e_lat: Vec3,
+    /// Contact point relative to the hub \[m\].
+    pub arm: Vec3,
+    /// Lever of the longitudinal force about the axle \[m\].
+    pub radius: f64,
+    /// Sticking forces: along the wheel `fx0 + dfx·ω` \[N\], across it `fy` \[N\].
+    pub fx0: f64,
+    pub dfx: f64,
+    pub fy: f64,
+    /// Sticking anchor deflections: along `ux0 + dux·ω`, across `uy` \[m\].
+    pub ux0: f64,
+    pub dux: f64,
+    pub uy: f64,
+    pub stiffness: f64,
+    /// μ·N \[N\].
+    pub limit: f64,
+}
+
+impl CoulombTyre {
+    /// The sticking forces (along, across) at spin rate `spin`.
+    #[inline]
+    pub fn trial(&self, spin: f64) -> (f64, f64) {
+        (self.fx0 + self.dfx * spin, self.fy)
+    }
+
+    /// Final forces (along, across) and anchor deflections at spin rate `spin`; `sliding`:
+    /// the longitudinal force the spin solve used for a sliding contact.
+    #[inline]
+    pub fn resolve(&self, spin: f64, sliding: Option<f64>) -> (f64, f64, f64, f64) {
+        let (fx, fy) = self.trial(spin);
+        let f = (fx * fx + fy * fy).sqrt();
+        match sliding {
+            None if f <= self.limit => (fx, fy, self.ux0 + self.dux * spin, self.uy),
+            _ => {
+                // sliding: the solve's longitudinal force, the rest of μ·N across, and the
+                // anchor slipped to where its spring alone carries that force
+                let fx = sliding.unwrap_or(self.limit * fx / f);
+                let rest = (self.limit * self.limit - fx * fx).max(0.0).sqrt();
+                let fy = if f > 0.0 {
+                    (self.limit * fy / f).clamp(-rest, rest)
+                } else {
+                    0.0
+                };
+                (fx, fy, fx / self.stiffness, fy / self.stiffness)
+            }
+        }
+    }
+}
+
+/// Sets up the Coulomb friction of a rigid tyre whose rigid contact carries more load than the
+/// soil under it. Returns the rolling-resistance torque on the spin and the contact's
+/// friction state (the tangential forces come after the spin solve, see [`CoulombTyre`]).
+#[inline]
+pub(crate) fn coulomb_tyre(
+    tyre: &TyreSpec,
+    ws: &WheelState,
+    contact: &WheelContact,
+    rigid: &RigidContact,
+    kin: &WheelKinematics,
+    h: f64,
+) -> (f64, CoulombTyre) {
+    let axle = kin.axle;
+    let n = contact.force.normalized();
+    let t = axle.cross(n);
+    // a push along the axle alone (the wheel's side against a rock): the wheel's forward axis
+    let e_long = if t.norm_sq() > 1e-12 {
+        t.normalized()
+    } else {
+        axle.cross(kin.up).normalized()
+    };
+    let e_lat = n.cross(e_long);
+    let arm = rigid.arm;
+    // the tread at `arm` moves at spin·(axle × arm); its part along e_long is −spin·radius
+    let radius = -axle.cross(arm).dot(e_long);
+    let v = kin.hub_velocity + kin.chassis_omega.cross(arm);
+    let (vx, vy) = (v.dot(e_long), v.dot(e_lat));
+    let (k, c) = (tyre.radial_stiffness, tyre.radial_damping);
+    // anchors after the step: u' = u + h·(ω·r − v_x) along, u − h·v_y across
+    let (ux0, dux, uy) = (ws.anchor_long - h * vx, h * radius, ws.anchor_lat - h * vy);
+    let ct = CoulombTyre {
+        e_long,
+        e_lat,
+        arm,
+        radius,
+        fx0: k * ux0 - c * vx,
+        dfx: radius * (k * h + c),
+        fy: k * uy - c * vy,
+        ux0,
+        dux,
+        uy,
+        stiffness: k,
+        limit: rigid.friction_limit,
+    };
+    let roll = if tyre.rolling_resistance > 0.0 {
+        -tyre.rolling_resistance * contact.rigid_load * radius * soft_sign(kin.spin * radius / 0.1)
+    } else {
+        0.0
+    };
+    (roll, ct)
 }

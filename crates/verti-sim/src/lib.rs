@@ -31,8 +31,9 @@
 //! # Inside
 //! One internal step runs stages over plain data (see `step.rs`, which reads as their list):
 //! `model` compiles the spec; `start` seats a vehicle; `drivetrain` steers, drives and solves
-//! the spins; `contact` (`wheel`, `soil`, `body`) finds normal forces; `friction` computes every
-//! tangential force; `suspension` and `integrate` advance the state. `terrain`, `soil` and
+//! the spins; `contact` (`wheel`, `soil`, `body`, and `rigid` for rigid tyres) finds normal
+//! forces; `friction` computes every tangential force; `suspension` and `integrate` advance the
+//! state; `step_rigid` is the wheel and spin stage of rigid tyres. `terrain`, `soil` and
 //! `tyre` hold the lookup structures, the soil storage and the tyre curves they use.
 
 mod contact;
@@ -48,6 +49,7 @@ pub mod spec;
 mod start;
 mod state;
 mod step;
+mod step_rigid;
 mod suspension;
 mod terrain;
 pub mod testing;

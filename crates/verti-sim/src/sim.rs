@@ -131,8 +131,8 @@ impl Sim {
     }
 
     /// Total mechanical energy \[J\]: kinetic (chassis, unsprung masses, spinning wheels) plus
-    /// gravity, suspension and tyre-spring potential. Soil deformation is dissipative and
-    /// not counted.
+    /// gravity, suspension and tyre-spring potential (a rigid tyre's: its contact and friction
+    /// anchor springs). Soil deformation is dissipative and not counted.
     pub fn energy(&self, state: &SimState) -> f64 {
         let model = &self.model;
         let q = state.orientation;
@@ -144,6 +144,7 @@ impl Sim {
             + model.sprung_mass * GRAVITY * state.position.z;
         let up = q.rotate(Vec3::Z);
         let k_tyre = self.spec.tyre.radial_stiffness;
+        let rigid = self.spec.tyre.model == crate::spec::TyreModel::Rigid;
         for (m, w) in model.wheels.iter().zip(&state.wheels) {
             let r = q.rotate(m.attach + Vec3::Z * w.compression);
             let v = state.velocity + omega_w.cross(r) + up * w.compression_rate;
@@ -158,7 +159,10 @@ impl Sim {
             }
             let d = w.tyre_deflection;
             e += 0.5 * k_tyre * d * d;
-            if d > m.rim_depth {
+            if rigid {
+                // the friction anchors' springs; a rigid tyre has no rim to bottom on
+                e += 0.5 * k_tyre * (w.anchor_long.powi(2) + w.anchor_lat.powi(2));
+            } else if d > m.rim_depth {
                 e += 0.5 * 10.0 * k_tyre * (d - m.rim_depth).powi(2);
             }
         }

@@ -107,12 +107,40 @@ pub struct WheelSpec {
     pub spin_inertia: f64,
 }
 
+/// Which force law the tyres follow (vehicle-wide, `tyre.model` in the file; `handling` when
+/// absent, so every file written before the choice existed keeps its meaning and its bits).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TyreModel {
+    /// A compliant tyre with a TMeasy-style combined-slip curve (the fields below).
+    #[default]
+    Handling,
+    /// A rigid cylinder (radius and width of the wheel) with Coulomb friction, like Chrono's
+    /// `ChRigidTire` under NSC contact: `radial_stiffness` and `radial_damping` are the stiff
+    /// penalty contact standing in for the complementarity constraint, `friction` the Coulomb
+    /// coefficient; the slip-curve fields are not used (`relaxation_length` still drives the
+    /// soil shear on deformable ground).
+    Rigid,
+}
+
+impl TyreModel {
+    /// True for the default (used to leave the field out of written files, so the YAML and the
+    /// digests of every handling-tyre vehicle are what they were before the field existed).
+    pub fn is_handling(&self) -> bool {
+        *self == TyreModel::Handling
+    }
+}
+
 /// Tyre force model: radial spring-damper plus a TMeasy-style combined-slip curve. Force values
 /// are per unit normal load at the tyre's own friction `friction`; on ground of lower friction
 /// the peak and sliding values scale down with the patch friction (Chrono combines by `min`).
+/// With `model: rigid` the tyre is a rigid cylinder instead (see [`TyreModel::Rigid`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TyreSpec {
+    /// The force law: `handling` (default) or `rigid`.
+    #[serde(default, skip_serializing_if = "TyreModel::is_handling")]
+    pub model: TyreModel,
     /// Radial stiffness \[N/m\].
     pub radial_stiffness: f64,
     /// Radial damping \[N s/m\].
@@ -641,8 +669,14 @@ impl VehicleSpec {
         );
         let _ = writeln!(
             s,
-            "  tyre             μ {}, Cz {:.3e} N/m, rolling resistance {}",
-            self.tyre.friction, self.tyre.radial_stiffness, self.tyre.rolling_resistance
+            "  tyre             {}μ {}, Cz {:.3e} N/m, rolling resistance {}",
+            match self.tyre.model {
+                TyreModel::Handling => "",
+                TyreModel::Rigid => "rigid cylinder, ",
+            },
+            self.tyre.friction,
+            self.tyre.radial_stiffness,
+            self.tyre.rolling_resistance
         );
         let _ = write!(s, "  internal step    {} ms", self.internal_step * 1e3);
         s

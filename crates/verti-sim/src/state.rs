@@ -94,6 +94,17 @@ pub struct WheelState {
     pub slip_lat: f64,
     /// Characteristic size b = 2A/L of the last soil contact patch \[m\] (Bekker's K_c/b term).
     pub soil_patch_b: f64,
+    /// Rigid tyre on rigid ground: the stick–slip friction anchor's deflection along the
+    /// wheel's longitudinal and lateral contact axes \[m\] (the ground pushes the wheel by
+    /// the contact stiffness times it; zero with the handling tyre).
+    #[serde(default)]
+    pub anchor_long: f64,
+    #[serde(default)]
+    pub anchor_lat: f64,
+    /// Rigid tyre on rigid ground: the contact slid (friction at μ·N) in the last internal
+    /// step. The next step's stick/slide decision starts from it.
+    #[serde(default)]
+    pub sliding: bool,
     // ---- outputs of the last internal step ----
     /// Road-wheel steer angle \[rad\].
     pub steer_angle: f64,
@@ -270,6 +281,9 @@ impl SimState {
             }
             if !(w.slip_long.is_finite() && w.slip_lat.is_finite()) {
                 return Err(nf(&format!("tyre slip of wheel {i}")));
+            }
+            if !(w.anchor_long.is_finite() && w.anchor_lat.is_finite()) {
+                return Err(nf(&format!("friction anchor of wheel {i}")));
             }
         }
         for (g, s) in self.group_spin.iter().enumerate() {

@@ -9,6 +9,9 @@
 //!    (linearised slip curve), then Coulomb brakes exactly;
 //! 3. the transient slip relaxes implicitly (`friction::relax_slip`; see [`crate::tyre`]).
 //!
+//! Rigid tyres (`tyre.model: rigid`) have their own wheel and spin stages
+//! ([`crate::step_rigid`]); everything else is shared.
+//!
 //! Every shipped vehicle is stable at its `internal_step`: 5 ms at full scale (Verti-Bench's
 //! step), 2 ms for the 1/6 and 1/10 vehicles. Stability at those steps is what the validation
 //! tests and the soak exercise.
@@ -26,7 +29,7 @@ use crate::friction::{self, TyreForces};
 use crate::integrate::{self, Loads};
 use crate::model::{GRAVITY, WheelModel};
 use crate::sim::Sim;
-use crate::spec::MAX_WHEELS;
+use crate::spec::{MAX_WHEELS, TyreModel};
 use crate::state::{ContactInfo, Controls, SimState, WheelState};
 use crate::suspension::{self, AxisLoad, spring_force};
 use verti_core::{Quat, Vec3};
@@ -78,54 +81,69 @@ impl Sim {
         // spin solve) ----
         let mut loads = Loads::gravity(gravity, model.sprung_mass);
         let mut contacts = ContactInfo::default();
-        let mut spin_loads = SpinLoads::ZERO;
         let mut axis_loads = [AxisLoad::default(); MAX_WHEELS];
-        let mut axles = [Vec3::ZERO; MAX_WHEELS];
         let mut tyres = [TyreForces::default(); MAX_WHEELS];
         let near = terrain.obstacles.near(st.position.x, st.position.y);
-        for (w, m) in model.wheels.iter().enumerate() {
-            let ws = st.wheels[w];
-            let kin = frame.wheel(st, m, &ws, turn_radius);
-            let soil_b = ws.soil_patch_b;
-            let contact = wheel_contact(terrain, &mut st.soil, &spec.tyre, m, soil_b, &kin, near);
-            let spring = spring_force(m, &ws);
-            let tyre = friction::tyre_forces(&spec.tyre, spec.scale, m, &ws, &contact, &kin, h);
+        let rigid = spec.tyre.model == TyreModel::Rigid;
+        if rigid {
+            let stage = RigidStage {
+                frame: &frame,
+                turn_radius,
+                wheel_torque,
+                near,
+                h,
+            };
+            let scratch = (&mut axis_loads, &mut tyres);
+            self.rigid_wheels(st, ctl, &stage, &mut loads, &mut contacts, scratch);
+        } else {
+            let mut spin_loads = SpinLoads::ZERO;
+            let mut axles = [Vec3::ZERO; MAX_WHEELS];
+            for (w, m) in model.wheels.iter().enumerate() {
+                let ws = st.wheels[w];
+                let kin = frame.wheel(st, m, &ws, turn_radius);
+                let soil_b = ws.soil_patch_b;
+                let contact =
+                    wheel_contact(terrain, &mut st.soil, &spec.tyre, m, soil_b, &kin, near);
+                let spring = spring_force(m, &ws);
+                let tyre = friction::tyre_forces(&spec.tyre, spec.scale, m, &ws, &contact, &kin, h);
 
-            // the spin gets rolling resistance and the soil pressure moment about the axle,
-            // the composite body everything else
-            let axle_moment = contact.soil_moment.dot(kin.axle);
-            spin_loads.add_wheel(m.group, tyre.roll_torque + axle_moment, &tyre.long);
-            let mut f_ext = gravity * m.unsprung_mass + contact.force;
-            if tyre.long.active {
-                f_ext += tyre.lat_force;
+                // the spin gets rolling resistance and the soil pressure moment about the axle,
+                // the composite body everything else
+                let axle_moment = contact.soil_moment.dot(kin.axle);
+                spin_loads.add_wheel(m.group, tyre.roll_torque + axle_moment, &tyre.long);
+                let mut f_ext = gravity * m.unsprung_mass + contact.force;
+                if tyre.long.active {
+                    f_ext += tyre.lat_force;
+                }
+                let soil_off_axle = contact.soil_moment - kin.axle * axle_moment;
+                let moments = (soil_off_axle, tyre.contact_moment);
+                let f_axis = loads.add_wheel(kin.arm, frame.up, f_ext, spring.force, moments);
+
+                axis_loads[w] = AxisLoad::new(kin.arm, f_axis, &spring, &contact);
+                axles[w] = kin.axle;
+                tyres[w] = tyre;
+                record_wheel(&mut st.wheels[w], &mut contacts, &contact, &tyre);
             }
-            let soil_off_axle = contact.soil_moment - kin.axle * axle_moment;
-            let moments = (soil_off_axle, tyre.contact_moment);
-            let f_axis = loads.add_wheel(kin.arm, frame.up, f_ext, spring.force, moments);
 
-            axis_loads[w] = AxisLoad::new(kin.arm, f_axis, &spring, &contact);
-            axles[w] = kin.axle;
-            tyres[w] = tyre;
-            record_wheel(&mut st.wheels[w], &mut contacts, &contact, &tyre);
-        }
-
-        // ---- spin groups: drive, brakes (exact Coulomb), skid steering; then the
-        // longitudinal tyre forces at the new spins and the drive reactions ----
-        let reaction = drivetrain::solve_spins(spec, model, st, ctl, wheel_torque, &spin_loads, h);
-        for (w, m) in model.wheels.iter().enumerate() {
-            let long = &tyres[w].long;
-            if !long.active {
-                st.wheels[w].long_force = 0.0;
-                continue;
+            // ---- spin groups: drive, brakes (exact Coulomb), skid steering; then the
+            // longitudinal tyre forces at the new spins and the drive reactions ----
+            let reaction =
+                drivetrain::solve_spins(spec, model, st, ctl, wheel_torque, &spin_loads, h);
+            for (w, m) in model.wheels.iter().enumerate() {
+                let long = &tyres[w].long;
+                if !long.active {
+                    st.wheels[w].long_force = 0.0;
+                    continue;
+                }
+                let fx = long.force_at(st.group_spin[m.group]);
+                let f_axis = loads.add_wheel_force(axis_loads[w].arm, frame.up, long.e_long * fx);
+                axis_loads[w].external += f_axis;
+                st.wheels[w].long_force = fx;
             }
-            let fx = long.force_at(st.group_spin[m.group]);
-            let f_axis = loads.add_wheel_force(axis_loads[w].arm, frame.up, long.e_long * fx);
-            axis_loads[w].external += f_axis;
-            st.wheels[w].long_force = fx;
-        }
-        for (w, m) in model.wheels.iter().enumerate() {
-            loads.torque += axles[w] * reaction[m.group];
-            st.wheels[w].spin_rate = st.group_spin[m.group];
+            for (w, m) in model.wheels.iter().enumerate() {
+                loads.torque += axles[w] * reaction[m.group];
+                st.wheels[w].spin_rate = st.group_spin[m.group];
+            }
         }
 
         // ---- chassis body contacts ----
@@ -139,8 +157,10 @@ impl Sim {
         for ((ws, m), load) in st.wheels.iter_mut().zip(&model.wheels).zip(&axis_loads) {
             suspension::update_wheel(ws, m, load, &acc, v, frame.omega, frame.up, h);
         }
-        for (ws, tyre) in st.wheels.iter_mut().zip(&tyres) {
-            friction::relax_slip(ws, tyre, &spec.tyre, h);
+        if !rigid {
+            for (ws, tyre) in st.wheels.iter_mut().zip(&tyres) {
+                friction::relax_slip(ws, tyre, &spec.tyre, h);
+            }
         }
         integrate::advance_chassis(model, st, &loads, &acc, h);
         st.contacts = contacts;
@@ -149,12 +169,22 @@ impl Sim {
 
 /// The chassis attitude at the start of an internal step: its axes and angular velocity in
 /// the world frame.
-struct Frame {
+pub(crate) struct Frame {
     q: Quat,
     ex: Vec3,
     ey: Vec3,
-    up: Vec3,
-    omega: Vec3,
+    pub up: Vec3,
+    pub omega: Vec3,
+}
+
+/// What the rigid tyres' stages need of the internal step ([`crate::step_rigid`]).
+pub(crate) struct RigidStage<'a> {
+    pub frame: &'a Frame,
+    pub turn_radius: f64,
+    pub wheel_torque: f64,
+    /// Obstacles near the vehicle.
+    pub near: &'a [u32],
+    pub h: f64,
 }
 
 impl Frame {
@@ -170,9 +200,10 @@ impl Frame {
         }
     }
 
-    /// Where wheel `m` (state `ws`) is and how it moves.
-    #[inline]
-    fn wheel(
+    /// Where wheel `m` (state `ws`) is and how it moves. (Always inlined, see
+    /// `friction::tyre_forces`.)
+    #[inline(always)]
+    pub(crate) fn wheel(
         &self,
         st: &SimState,
         m: &WheelModel,
@@ -195,7 +226,7 @@ impl Frame {
 
 /// The wheel's outputs of this internal step, and its share of the contact summary.
 #[inline]
-fn record_wheel(
+pub(crate) fn record_wheel(
     out: &mut WheelState,
     contacts: &mut ContactInfo,
     contact: &WheelContact,

@@ -322,6 +322,30 @@ impl Ground {
     }
 }
 
+/// A height-only probe of the same surface, for contact samples that are usually above the
+/// ground (the rigid tyre's fan of points along its tread): the slopes are computed only for
+/// the few that touch.
+impl Ground {
+    /// Exactly the height of [`Ground::sample`] at (x, y), without the slopes.
+    #[inline]
+    pub fn height(&self, x: f64, y: f64) -> f64 {
+        let gc = (x * self.inv_cell + self.half).max(0.0).min(self.max_index);
+        let gr = (self.half - y * self.inv_cell).max(0.0).min(self.max_index);
+        let c0 = (gc as usize).min(self.n - 2);
+        let r0 = (gr as usize).min(self.n - 2);
+        let u = gc - c0 as f64;
+        let v = 1.0 - (gr - r0 as f64);
+        let base = r0 * self.n + c0;
+        let (nw, ne, sw, se) = (base, base + 1, base + self.n, base + self.n + 1);
+        let h = &self.heights;
+        if u >= v {
+            h[sw] + u * (h[se] - h[sw]) + v * (h[ne] - h[se])
+        } else {
+            h[sw] + v * (h[nw] - h[sw]) + u * (h[ne] - h[nw])
+        }
+    }
+}
+
 /// See [`Ground::row`].
 pub struct GroundRow<'a> {
     ground: &'a Ground,
@@ -507,6 +531,11 @@ mod tests {
             assert!((a.0 - w.terrain.height_at(x, y)).abs() < 1e-9);
             let (r, c) = w.patches.index_at(x, y);
             assert_eq!(g.patch_index(x, y), r * 16 + c);
+        }
+        // the height probe is the same surface, to the bit
+        for _ in 0..2000 {
+            let (x, y) = (rng.range(-70.0, 70.0), rng.range(-70.0, 70.0));
+            assert_eq!(g.height(x, y), g.sample(x, y).0);
         }
         // the row sampler is the same function
         for _ in 0..500 {

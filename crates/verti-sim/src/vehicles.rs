@@ -7,6 +7,8 @@ use crate::spec::VehicleSpec;
 /// (name, YAML text) of every built-in vehicle, in display order.
 const BUILTINS: &[(&str, &str)] = &[
     ("hmmwv", include_str!("../vehicles/hmmwv.yaml")),
+    // the same HMMWV on Chrono's rigid tyres (Verti-Bench's configuration)
+    ("hmmwv-rigid", include_str!("../vehicles/hmmwv-rigid.yaml")),
     ("artcar", include_str!("../vehicles/artcar.yaml")),
     ("verti4", include_str!("../vehicles/verti4.yaml")),
     ("truck6", include_str!("../vehicles/truck6.yaml")),

@@ -12,7 +12,15 @@ fn builtin_vehicles_load_and_unknown_names_list_the_known_ones() {
     let names = vehicles::builtin_names();
     assert_eq!(
         names,
-        ["hmmwv", "artcar", "verti4", "truck6", "truck8", "m113"]
+        [
+            "hmmwv",
+            "hmmwv-rigid",
+            "artcar",
+            "verti4",
+            "truck6",
+            "truck8",
+            "m113"
+        ]
     );
     for name in &names {
         let spec = vehicles::builtin(name).unwrap();

@@ -2,6 +2,7 @@
 //!
 //! * [`wheel`]: one wheel against rigid ground and obstacles (a compliant tyre), handing the
 //!   soil under it to [`soil`];
+//! * [`rigid`]: the same for a rigid tyre (a rigid cylinder, `tyre.model: rigid`);
 //! * [`soil`]: SCM under one wheel (pressure–sinkage per node, plastic memory);
 //! * [`body`]: the chassis collision box against terrain and obstacles.
 //!
@@ -10,6 +11,7 @@
 //! included, directly.
 
 pub(crate) mod body;
+pub(crate) mod rigid;
 pub(crate) mod soil;
 pub(crate) mod wheel;
 

@@ -12,6 +12,20 @@ use verti_core::Vec3;
 /// Safety cap on soil nodes visited per wheel per step.
 pub(crate) const MAX_SOIL_NODES_PER_WHEEL: usize = 4096;
 
+/// True when the soil grid cannot resolve this wheel, so the soil acts as rigid ground under
+/// it: a tread narrower than the node spacing (a 1/10 vehicle on a full-scale world) could
+/// fall between nodes, and a wheel far too big for the grid would visit thousands of nodes.
+#[inline]
+pub(crate) fn soil_as_rigid(terrain: &Terrain, m: &WheelModel) -> bool {
+    let r = m.radius;
+    terrain.soil.is_none_or(|l| {
+        let span = (2.0 * r + 2.0 * m.half_width) / l.delta + 2.0;
+        span * span > MAX_SOIL_NODES_PER_WHEEL as f64
+            || 2.0 * m.half_width < l.delta
+            || r < 1.5 * l.delta
+    })
+}
+
 /// Contact of one wheel with rigid terrain, obstacles (indices `near`) and soil. Writes the
 /// soil's plastic memory under the wheel. `soil_b`: the size of the wheel's last soil patch.
 #[inline]
@@ -48,15 +62,7 @@ pub(crate) fn wheel_contact(
         .max_in(hub.x - r, hub.y - r, hub.x + r, hub.y + r);
     let near_ground = lowest_z < ground_max;
 
-    // Soil needs a grid that resolves the wheel: a tread narrower than the node spacing
-    // (a 1/10 vehicle on a full-scale world) could fall between nodes, and a wheel far too
-    // big for it would visit thousands. Both cases drive on the soil as rigid ground.
-    let soil_as_rigid = terrain.soil.is_none_or(|l| {
-        let span = (2.0 * r + 2.0 * m.half_width) / l.delta + 2.0;
-        span * span > MAX_SOIL_NODES_PER_WHEEL as f64
-            || 2.0 * m.half_width < l.delta
-            || r < 1.5 * l.delta
-    });
+    let soil_as_rigid = soil_as_rigid(terrain, m);
     let mut best_depth = 0.0;
     let mut best_normal = Vec3::Z;
     let mut best_mu = 1.0;

@@ -152,13 +152,13 @@ impl fmt::Display for BenchReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "{:<8} {:<6} {:>8} {:>10} {:>10} {:>10} {:>9} {:>9}  note",
+            "{:<11} {:<6} {:>8} {:>10} {:>10} {:>10} {:>9} {:>9}  note",
             "vehicle", "ground", "sim s", "RTF", "best RTF", "µs/step", "steps", "dist m"
         )?;
         for c in &self.cases {
             writeln!(
                 f,
-                "{:<8} {:<6} {:>8.1} {:>9.0}x {:>9.0}x {:>10.3} {:>9} {:>9.1}  {}",
+                "{:<11} {:<6} {:>8.1} {:>9.0}x {:>9.0}x {:>10.3} {:>9} {:>9.1}  {}",
                 c.vehicle,
                 c.terrain,
                 c.sim_seconds,
