@@ -174,8 +174,7 @@ pub(crate) fn rigid_wheel_contact(
         axle,
     };
 
-    // In-plane direction of "down" (toward the lowest point of the wheel) and the forward
-    // direction: a basis of the wheel's plane.
+    // World "down" within the wheel's plane (with axle × down it spans that plane).
     let down = {
         let d = Vec3::new(0.0, 0.0, -1.0) - axle * (-axle.z);
         let n = d.norm();
