@@ -71,3 +71,33 @@ impl WheelContact {
         self.rigid_load + self.soil_load
     }
 }
+
+/// The broad phase of a wheel (radius `r`, half width `half_width`, hub at `hub`) against
+/// obstacle `k`: `None` when the obstacle is out of reach by its planar circle, its height
+/// range or its bounding sphere (cheapest test first), else its fast geometry. Shared by both
+/// tyre models so they skip exactly the same obstacles.
+#[inline]
+pub(crate) fn obstacle_in_reach(
+    terrain: &crate::terrain::Terrain,
+    k: u32,
+    hub: Vec3,
+    r: f64,
+    half_width: f64,
+) -> Option<&crate::terrain::FastObstacle> {
+    let o = &terrain.world.obstacles[k as usize];
+    let op = o.position();
+    let reach = o.radius_xy() + r + half_width;
+    if (hub.x - op.x).powi(2) + (hub.y - op.y).powi(2) > reach * reach {
+        return None;
+    }
+    let (z0, z1) = o.z_range();
+    if hub.z - r > z1 || hub.z + r < z0 {
+        return None;
+    }
+    let fo = &terrain.fast_obstacles[k as usize];
+    let reach3 = fo.radius + r + half_width;
+    if (hub - fo.center).norm_sq() > reach3 * reach3 {
+        return None;
+    }
+    Some(fo)
+}

@@ -267,21 +267,9 @@ pub(crate) fn rigid_wheel_contact(
     // Obstacles. (e1, e2) = (axle × down, −down): an orthonormal basis of the wheel's plane.
     let e1 = axle.cross(down);
     for &k in near {
-        let o = &world.obstacles[k as usize];
-        let op = o.position();
-        let reach = o.radius_xy() + r + hw;
-        if (hub.x - op.x).powi(2) + (hub.y - op.y).powi(2) > reach * reach {
+        let Some(fo) = super::obstacle_in_reach(terrain, k, hub, r, hw) else {
             continue;
-        }
-        let (z0, z1) = o.z_range();
-        if hub.z - r > z1 || hub.z + r < z0 {
-            continue;
-        }
-        let fo = &terrain.fast_obstacles[k as usize];
-        let reach3 = fo.radius + r + hw;
-        if (hub - fo.center).norm_sq() > reach3 * reach3 {
-            continue;
-        }
+        };
         // a lower bound of the hub's distance to the obstacle
         let (d_hub, n_hub) = fo.signed_distance(hub);
         if d_hub > r + hw {

@@ -150,21 +150,9 @@ pub(crate) fn wheel_contact(
     // Obstacles: the cylinder's support point toward the nearest face.
     let mut obstacle_best: Option<(f64, Vec3)> = None;
     for &k in near {
-        let o = &world.obstacles[k as usize];
-        let op = o.position();
-        let reach = o.radius_xy() + r + m.half_width;
-        if (hub.x - op.x).powi(2) + (hub.y - op.y).powi(2) > reach * reach {
+        let Some(fo) = super::obstacle_in_reach(terrain, k, hub, r, m.half_width) else {
             continue;
-        }
-        let (z0, z1) = o.z_range();
-        if hub.z - r > z1 || hub.z + r < z0 {
-            continue;
-        }
-        let fo = &terrain.fast_obstacles[k as usize];
-        let reach3 = fo.radius + r + m.half_width;
-        if (hub - fo.center).norm_sq() > reach3 * reach3 {
-            continue;
-        }
+        };
         let (d_hub, n_hub) = fo.signed_distance(hub);
         if d_hub > r + m.half_width {
             continue;
