@@ -141,13 +141,8 @@ impl RunRecord {
     /// by value after resolution (missing ones at their defaults); `tasks` is not compared.
     pub fn differences(&self, recorded: &RunRecord) -> Vec<String> {
         let mut out = Vec::new();
-        let mut differ = |what: &str, was: String, now: String| {
-            if was != now {
-                out.push(format!("{what}: {was} recorded, {now} now"));
-            }
-        };
         let (a, b) = (&recorded.run, &self.run);
-        differ("system", a.system.clone(), b.system.clone());
+        differ(&mut out, "system", a.system.clone(), b.system.clone());
         match (&recorded.worlds_digest, &self.worlds_digest) {
             (Some(x), Some(y)) if x != y => out.push(format!(
                 "world set: its contents differ (`{}` recorded, `{}` now; world-set digest {} recorded, {} now)",
@@ -157,32 +152,35 @@ impl RunRecord {
                 short(y)
             )),
             (Some(_), Some(_)) => {}
-            _ => differ("world set", a.worlds.clone(), b.worlds.clone()),
+            _ => differ(&mut out, "world set", a.worlds.clone(), b.worlds.clone()),
         }
-        let mut differ = |what: &str, was: String, now: String| {
-            if was != now {
-                out.push(format!("{what}: {was} recorded, {now} now"));
-            }
-        };
         match (&recorded.vehicle_digest, &self.vehicle_digest) {
             (Some(x), Some(y)) if x != y => differ(
+                &mut out,
                 "vehicle",
                 format!("`{}` (digest {})", a.vehicle, short(x)),
                 format!("`{}` (digest {})", b.vehicle, short(y)),
             ),
             (Some(_), Some(_)) => {}
-            _ => differ("vehicle", a.vehicle.clone(), b.vehicle.clone()),
+            _ => differ(&mut out, "vehicle", a.vehicle.clone(), b.vehicle.clone()),
         }
-        differ("scale", a.scale.to_string(), b.scale.to_string());
-        differ("rules", json(&a.rules), json(&b.rules));
-        differ("seed", a.seed.to_string(), b.seed.to_string());
-        differ("max_time", a.max_time.to_string(), b.max_time.to_string());
+        differ(&mut out, "scale", a.scale.to_string(), b.scale.to_string());
+        differ(&mut out, "rules", json(&a.rules), json(&b.rules));
+        differ(&mut out, "seed", a.seed.to_string(), b.seed.to_string());
         differ(
+            &mut out,
+            "max_time",
+            a.max_time.to_string(),
+            b.max_time.to_string(),
+        );
+        differ(
+            &mut out,
             "start",
             recorded.start.name().to_string(),
             self.start.name().to_string(),
         );
         differ(
+            &mut out,
             "step logs",
             recorded.step_log.clone().unwrap_or("none".into()),
             self.step_log.clone().unwrap_or("none".into()),
@@ -191,6 +189,13 @@ impl RunRecord {
             out.extend(param_differences(&b.params, &a.params));
         }
         out
+    }
+}
+
+/// Notes `what` in `out` when its recorded and current values differ.
+fn differ(out: &mut Vec<String>, what: &str, was: String, now: String) {
+    if was != now {
+        out.push(format!("{what}: {was} recorded, {now} now"));
     }
 }
 
