@@ -278,8 +278,9 @@ pub(super) fn evaluate(
         return results_to_py(py, &results);
     };
 
-    // With a results folder: verti_bench::eval::evaluate (the CLI's resumable runner), in
-    // chunks so Ctrl-C can stop between them; every chunk resumes the same run.
+    // With a results folder: verti_bench::eval::evaluate (the CLI's resumable runner) in one
+    // call. Ctrl-C raises `cancel` while it runs (see `interruptible`), so it needs no chunks
+    // (which digested the worlds and re-read the results file once per chunk).
     let numbers: Vec<u32> = selected
         .iter()
         .map(|&(wi, pair)| {
@@ -307,17 +308,18 @@ pub(super) fn evaluate(
             .unwrap_or_else(|p| p.into_inner())
             .push(m.to_string())
     };
+    // `evaluate` reads an empty selection as "all tasks"; nothing selected runs nothing
     let mut all = Vec::new();
-    for (k, chunk) in numbers.chunks((4 * jobs).max(16)).enumerate() {
+    if !numbers.is_empty() {
         let setup = EvalSetup {
             worlds: &worlds,
             vehicle: &spec,
             episode: episode.clone(),
             jobs,
             out: out.clone(),
-            resume: resume || k > 0,
-            force: force && k == 0,
-            run: run.clone(),
+            resume,
+            force,
+            run,
             step_log: None,
             cancel: Some(&cancel),
             warn: Some(&note),
@@ -330,7 +332,7 @@ pub(super) fn evaluate(
             })
         };
         all = interruptible(py, &cancel, || {
-            verti_bench::eval::evaluate(&setup, chunk, &make, &|_| {})
+            verti_bench::eval::evaluate(&setup, &numbers, &make, &|_| {})
         })?
         .map_err(eval_err)?;
     }
