@@ -3,13 +3,17 @@
 //! * [`wheel`]: one wheel against rigid ground and obstacles (a compliant tyre), handing the
 //!   soil under it to [`soil`];
 //! * [`soil`]: SCM under one wheel (pressure–sinkage per node, plastic memory);
-//! * [`body`]: the chassis collision box against terrain and obstacles.
+//! * [`body`]: the chassis collision box against terrain and obstacles;
+//! * [`belly`]: the box's bottom face against the terrain between its lattice points.
 //!
 //! Wheel contacts return a [`WheelContact`] summary; their tangential forces come later from
 //! the slip state (`friction::tyre_forces`). Body contacts apply their forces, friction
 //! included, directly.
 
+pub(crate) mod belly;
 pub(crate) mod body;
+#[cfg(test)]
+mod body_tests;
 pub(crate) mod soil;
 pub(crate) mod wheel;
 
