@@ -178,7 +178,9 @@ impl Model {
                 });
             }
         }
-        // Chassis collision points: the 18 points of a 3x3x2 lattice on the collision box.
+        // Chassis collision points: the 18 points of a 3x3x2 lattice on the collision box,
+        // bottom face first; within a face x from rear to front, y from right to left within
+        // each x (`contact::belly` reads the bottom nine in this order).
         let bx = &spec.chassis.collision_box;
         let box_center = Vec3::new(bx.center[0], bx.center[1], bx.center[2]) - com;
         let box_half = Vec3::new(bx.size[0], bx.size[1], bx.size[2]) * 0.5;

@@ -5,6 +5,7 @@
 
 use crate::error::SimError;
 use crate::soil::{SOIL_DELTA_FULL_SCALE, SoilLayout};
+use std::ops::RangeInclusive;
 use std::sync::Arc;
 use verti_world::World;
 
@@ -20,6 +21,8 @@ pub(crate) struct Terrain {
     pub fast_obstacles: Vec<FastObstacle>,
     /// The soil node grid, when the world has deformable patches.
     pub soil: Option<SoilLayout>,
+    /// Whether any patch is rigid (the belly contacts act on rigid ground only).
+    pub rigid_patches: bool,
 }
 
 impl Terrain {
@@ -45,6 +48,11 @@ impl Terrain {
             obstacles: ObstacleGrid::new(world, reach),
             world: Arc::clone(world),
             soil,
+            rigid_patches: world
+                .patches
+                .patches()
+                .iter()
+                .any(|p| !p.surface.is_deformable()),
         })
     }
 }
@@ -199,6 +207,7 @@ impl ObstacleGrid {
 #[derive(Clone, Debug)]
 pub struct Ground {
     n: usize,
+    cell: f64,
     inv_cell: f64,
     half: f64,
     max_index: f64,
@@ -229,6 +238,7 @@ impl Ground {
         }
         Ground {
             n,
+            cell,
             inv_cell: 1.0 / cell,
             half: 0.5 * (n - 1) as f64,
             max_index: (n - 1) as f64,
@@ -297,6 +307,52 @@ impl Ground {
         (height, sx * keep_x, sy * keep_y)
     }
 
+    /// Size of one heightfield cell \[m\].
+    #[inline]
+    pub fn cell(&self) -> f64 {
+        self.cell
+    }
+
+    /// The rows of vertices whose world y lies in \[y0, y1\], clamped to the map.
+    #[inline]
+    pub fn rows_in(&self, y0: f64, y1: f64) -> Option<RangeInclusive<usize>> {
+        index_span(
+            self.half - y1 * self.inv_cell,
+            self.half - y0 * self.inv_cell,
+            self.max_index,
+        )
+    }
+
+    /// The columns of vertices whose world x lies in \[x0, x1\], clamped to the map.
+    #[inline]
+    pub fn columns_in(&self, x0: f64, x1: f64) -> Option<RangeInclusive<usize>> {
+        index_span(
+            x0 * self.inv_cell + self.half,
+            x1 * self.inv_cell + self.half,
+            self.max_index,
+        )
+    }
+
+    /// World x of the vertices of column `col` (`Heightfield::vertex_xy`'s numbers).
+    #[inline]
+    pub fn vertex_x(&self, col: usize) -> f64 {
+        // via i64 (one instruction; the same value, far below 2^53)
+        (col as i64 as f64 - self.half) * self.cell
+    }
+
+    /// World y of the vertices of row `row` (row 0 = north).
+    #[inline]
+    pub fn vertex_y(&self, row: usize) -> f64 {
+        (self.half - row as i64 as f64) * self.cell
+    }
+
+    /// Heights of the vertices of row `row` in the columns `cols` (from [`Ground::columns_in`]).
+    #[inline]
+    pub fn row_heights(&self, row: usize, cols: &RangeInclusive<usize>) -> &[f64] {
+        let base = row * self.n;
+        &self.heights[base + *cols.start()..=base + *cols.end()]
+    }
+
     /// A sampler for points on one line of constant y: the row-dependent half of [`Ground::sample`]
     /// is done once (the soil loop samples tens of nodes per row).
     #[inline]
@@ -344,6 +400,24 @@ impl Ground {
             h[sw] + v * (h[nw] - h[sw]) + u * (h[ne] - h[nw])
         }
     }
+}
+
+/// The integers in \[lo, hi\] ∩ \[0, max\] as an inclusive range; `None` when there are none.
+/// Clamped before the casts, so truncation is floor and no library call is made.
+#[inline]
+fn index_span(lo: f64, hi: f64, max: f64) -> Option<RangeInclusive<usize>> {
+    // written so that NaN bounds give None
+    if !(hi >= 0.0 && lo <= max && lo <= hi) {
+        return None;
+    }
+    // via i64: a single instruction each way on x86-64, where usize takes several
+    let lo = lo.max(0.0);
+    let mut first = lo as i64;
+    if (first as f64) < lo {
+        first += 1;
+    }
+    let last = hi.min(max) as i64;
+    (first <= last).then_some(first as usize..=last as usize)
 }
 
 /// See [`Ground::row`].

@@ -144,6 +144,25 @@ pub fn bumpy_world(scale: f64, amplitude: f64, wavelength: f64, friction: f64) -
     )
 }
 
+/// Flat rigid ground with one ridge: the row of vertices at x = `ridge_x` (world units, a
+/// multiple of the cell, `scale`) raised by `height` (world units), a tent one cell wide on
+/// each side running along y: the thinnest ridge a height map can hold.
+pub fn ridge_world(scale: f64, friction: f64, ridge_x: f64, height: f64) -> World {
+    world_from_fn(
+        "ridge",
+        scale,
+        move |x, _| {
+            if (x - ridge_x).abs() < 0.5 * scale {
+                height
+            } else {
+                0.0
+            }
+        },
+        uniform(rigid_patch(friction)),
+        Vec::new(),
+    )
+}
+
 /// Flat ground with one box rock of full size `size` (world units, already scaled) whose
 /// near face is at x = `front_x`, centred on y = 0, sitting on the ground.
 pub fn rock_world(scale: f64, friction: f64, front_x: f64, size: Vec3) -> World {

@@ -1,6 +1,9 @@
 //! The chassis collision box against terrain (rigid, or the undeformed soil surface) and
 //! obstacles: a compliant normal force plus regularised Coulomb friction at each contact point.
+//! Against terrain: the 18 lattice points of the box, and the terrain vertices under its
+//! bottom face that stand above the ground the lattice sees ([`super::belly`]).
 
+use crate::contact::belly::{Push, belly_contacts};
 use crate::friction::{OBSTACLE_FRICTION, body_friction, surface_mu};
 use crate::integrate::Loads;
 use crate::model::Model;
@@ -42,12 +45,15 @@ pub(crate) fn body_contacts(
         x1 = x1.max(w.x);
         y1 = y1.max(w.y);
     }
-    // `stiff` = 1 for terrain, OBSTACLE_STIFFENING for obstacles
-    let mut apply = |point: Vec3, n: Vec3, depth: f64, mu: f64, stiff: f64| {
+    // `k_scale`, `c_scale`: the contact's stiffness and damping relative to one lattice point
+    // against terrain (1, 1); obstacles are a stiffer material (OBSTACLE_STIFFENING and its
+    // root: the same damping ratio), belly contacts a share of the face (the same factor for
+    // both: damping per area, see `belly`)
+    let mut apply = |point: Vec3, n: Vec3, depth: f64, mu: f64, k_scale: f64, c_scale: f64| {
         let arm = point - st.position;
         let v = st.velocity + omega_w.cross(arm);
         let vn = v.dot(n);
-        let fnorm = stiff * model.body_stiffness * depth - stiff.sqrt() * model.body_damping * vn;
+        let fnorm = k_scale * model.body_stiffness * depth - c_scale * model.body_damping * vn;
         if fnorm <= 0.0 {
             return false;
         }
@@ -60,12 +66,17 @@ pub(crate) fn body_contacts(
     let box_bound = terrain.bound.max_in(x0, y0, x1, y1);
     if z0 < box_bound {
         let patches = world.patches.patches();
-        for p in &pts {
+        // ground heights under the bottom points, where sampled (the belly pass reuses them)
+        let mut bottom_h = [f64::NAN; 9];
+        for (k, p) in pts.iter().enumerate() {
             // cheap compare against the whole box's bound first, then the point's own block
             if p.z >= box_bound || p.z >= terrain.bound.max_at(p.x, p.y) {
                 continue;
             }
             let (h, gx, gy) = terrain.ground.sample(p.x, p.y);
+            if k < 9 {
+                bottom_h[k] = h;
+            }
             if h <= p.z {
                 continue;
             }
@@ -73,12 +84,23 @@ pub(crate) fn body_contacts(
             let n = Vec3::new(-gx * nz, -gy * nz, nz);
             let surface = &patches[terrain.ground.patch_index(p.x, p.y)].surface;
             let mu = surface_mu(surface).min(mu_body);
-            if apply(*p, n, (h - p.z) * nz, mu, 1.0) {
+            if apply(*p, n, (h - p.z) * nz, mu, 1.0, 1.0) {
                 contacts.chassis_terrain_points += 1;
             }
         }
+        // the terrain between the lattice points: ridges and step edges under the belly
+        contacts.chassis_terrain_points += belly_contacts(
+            terrain,
+            model,
+            &rm,
+            &pts[..9],
+            &bottom_h,
+            mu_body,
+            |c: Push| apply(c.point, c.normal, c.depth, c.mu, c.share, c.share),
+        );
     }
     let mu_obs = OBSTACLE_FRICTION.min(mu_body);
+    let (k_obs, c_obs) = (OBSTACLE_STIFFENING, OBSTACLE_STIFFENING.sqrt());
     for &k in near {
         let o = &world.obstacles[k as usize];
         let op = o.position();
@@ -116,13 +138,7 @@ pub(crate) fn body_contacts(
                 let (depth, n_local) = box_penetration(local, v_local, d);
                 let n = q.rotate(n_local);
                 // contact on the trunk's surface facing the box
-                if apply(
-                    axis_point + n * radius,
-                    n,
-                    depth,
-                    mu_obs,
-                    OBSTACLE_STIFFENING,
-                ) {
+                if apply(axis_point + n * radius, n, depth, mu_obs, k_obs, c_obs) {
                     contacts.chassis_obstacle_points += 1;
                 }
             }
@@ -135,7 +151,7 @@ pub(crate) fn body_contacts(
                 continue;
             }
             let (d, n) = fo.signed_distance(*p);
-            if d < 0.0 && apply(*p, n, -d, mu_obs, OBSTACLE_STIFFENING) {
+            if d < 0.0 && apply(*p, n, -d, mu_obs, k_obs, c_obs) {
                 contacts.chassis_obstacle_points += 1;
             }
         }
@@ -153,7 +169,7 @@ pub(crate) fn body_contacts(
             }
             let v_local = -q.inverse_rotate(st.velocity + omega_w.cross(*v - st.position));
             let (depth, n_local) = box_penetration(local, v_local, d);
-            if apply(*v, q.rotate(n_local), depth, mu_obs, OBSTACLE_STIFFENING) {
+            if apply(*v, q.rotate(n_local), depth, mu_obs, k_obs, c_obs) {
                 contacts.chassis_obstacle_points += 1;
             }
         }

@@ -4,13 +4,17 @@
 //!   soil under it to [`soil`];
 //! * [`rigid`]: the same for a rigid tyre (a rigid cylinder, `tyre.model: rigid`);
 //! * [`soil`]: SCM under one wheel (pressure–sinkage per node, plastic memory);
-//! * [`body`]: the chassis collision box against terrain and obstacles.
+//! * [`body`]: the chassis collision box against terrain and obstacles;
+//! * [`belly`]: the box's bottom face against the terrain between its lattice points.
 //!
 //! Wheel contacts return a [`WheelContact`] summary; their tangential forces come later from
 //! the slip state (`friction::tyre_forces`). Body contacts apply their forces, friction
 //! included, directly.
 
+pub(crate) mod belly;
 pub(crate) mod body;
+#[cfg(test)]
+mod body_tests;
 pub(crate) mod rigid;
 pub(crate) mod soil;
 pub(crate) mod wheel;
