@@ -9,6 +9,7 @@ use clap::Args;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use verti_bench::Outcome;
+use verti_compare::ensemble::run_ensemble;
 use verti_compare::markdown::{engine_label, markdown};
 use verti_compare::reference::Sample;
 use verti_compare::{
@@ -56,6 +57,14 @@ pub struct CompareArgs {
     /// the ground) or `settled` (the benchmark's default, at rest on the ground).
     #[arg(long, default_value = "drop", value_parser = parse_start)]
     start: verti_bench::StartMode,
+    /// Runs per task: 1 (default) runs each task once; N > 1 adds N − 1 runs from starts up to
+    /// --jitter metres away, and reports the agreement to expect and the ceiling the tasks'
+    /// chaos sets on it (the pages show the first run).
+    #[arg(long, default_value_t = 1)]
+    ensemble: usize,
+    /// Largest start offset of the ensemble's runs, metres.
+    #[arg(long, default_value_t = verti_compare::ensemble::DEFAULT_JITTER)]
+    jitter: f64,
 }
 
 fn parse_start(s: &str) -> Result<verti_bench::StartMode, String> {
@@ -88,6 +97,12 @@ pub fn compare(a: CompareArgs) -> CmdResult {
         .episode
         .validate()
         .map_err(|e| format!("--inner-dt: {e}"))?;
+    if a.ensemble == 0 || a.ensemble > 1000 {
+        return Err(format!("--ensemble {}: give 1 to 1000 runs per task", a.ensemble).into());
+    }
+    if !(a.jitter.is_finite() && a.jitter > 0.0 && a.jitter <= 10.0) {
+        return Err(format!("--jitter {}: give a distance in (0, 10] metres", a.jitter).into());
+    }
     let refs: Vec<&RefTask> = chosen.iter().map(|&i| &reference.tasks[i]).collect();
     let worlds = load_worlds(
         &a.vb_worlds,
@@ -132,7 +147,33 @@ pub fn compare(a: CompareArgs) -> CmdResult {
         .zip(&runs)
         .map(|(r, run)| compare_task(r, run))
         .collect();
-    let summary = summarize(&setup, &engine, comparisons);
+    let mut summary = summarize(&setup, &engine, comparisons);
+    if a.ensemble > 1 {
+        let members: Vec<_> = summary
+            .tasks
+            .iter()
+            .map(|t| (t.world_index, t.pair, t.level, t.reference.outcome))
+            .collect();
+        let first: Vec<Outcome> = runs.iter().map(|r| r.result.outcome).collect();
+        let pb = bar((members.len() * (a.ensemble - 1)) as u64, "ensemble runs");
+        let t_ens = std::time::Instant::now();
+        summary.ensemble = Some(run_ensemble(
+            &worlds,
+            &members,
+            &first,
+            &setup,
+            a.ensemble,
+            a.jitter,
+            jobs,
+            &|| pb.inc(1),
+        )?);
+        pb.finish_and_clear();
+        eprintln!(
+            "ensemble: {} more runs in {:.1} s",
+            members.len() * (a.ensemble - 1),
+            t_ens.elapsed().as_secs_f64()
+        );
+    }
     let md = markdown(&summary);
     let json = serde_json::to_string_pretty(&summary)?;
     write(&a.out.join("summary.md"), &md)?;

@@ -10,6 +10,8 @@
 //!   deterministically.
 //! * [`driver`]: the reference runs' own driver law, to measure what the PID's differences
 //!   from it change.
+//! * [`ensemble`]: each task re-run from starts a few centimetres apart, for the agreement one
+//!   run can be expected to reach on chaotic tasks.
 //! * [`divergence`]: lateral offset from the reference's trajectory and roll error.
 //! * [`summary`]: per-task comparison and aggregates; [`markdown`]: the report's tables.
 //!
@@ -18,6 +20,7 @@
 
 pub mod divergence;
 pub mod driver;
+pub mod ensemble;
 pub mod error;
 pub mod markdown;
 pub mod reference;

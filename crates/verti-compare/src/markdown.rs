@@ -137,9 +137,67 @@ pub fn markdown(s: &Summary) -> String {
             num(a.whole.max_roll_error, 1),
         );
     }
+    if let Some(e) = &s.ensemble {
+        ensemble(&mut out, &r, e);
+    }
     confusion(&mut out, &r, &s.tasks);
     per_task(&mut out, &r, &s.tasks);
     out
+}
+
+/// The ensemble's tables: expected agreement against the ceiling the tasks' chaos sets.
+fn ensemble(out: &mut String, r: &str, e: &crate::ensemble::Ensemble) {
+    let _ = writeln!(
+        out,
+        "\n## Ensemble: {} runs per task, starts up to {} cm apart\n\nExpected agreement: the share of verti's runs ending as {r}'s did, averaged over tasks. Self-agreement: the chance that two of verti's runs of a task end alike, the ceiling the tasks' chaos sets on any agreement. Settled tasks: every run ended the same way.\n\n| | tasks | expected agreement | self-agreement | settled tasks (agreeing) | {r} success / stuck / rollover | verti expected success / stuck / rollover |\n|---|---:|---:|---:|---:|---|---|",
+        e.members,
+        num(100.0 * e.jitter, 1)
+    );
+    for g in &e.groups {
+        let x = &g.expected;
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.0} % | {:.0} % | {} ({}) | {} | {} / {} / {}{} |",
+            g.group,
+            g.tasks,
+            100.0 * g.expected_agreement,
+            100.0 * g.self_agreement,
+            g.settled_tasks,
+            g.settled_agreeing,
+            counts(&g.reference),
+            num(x.success, 1),
+            num(x.stuck, 1),
+            num(x.rollover, 1),
+            if x.timeout + x.error > 0.0 {
+                format!(" (+{} timeout/error)", num(x.timeout + x.error, 1))
+            } else {
+                String::new()
+            }
+        );
+    }
+    let _ = writeln!(
+        out,
+        "\n| world | pair | {r} | verti runs: success / stuck / rollover / other | share as {r} |\n|---|---:|---|---|---:|"
+    );
+    for t in e
+        .tasks
+        .iter()
+        .filter(|t| t.self_agreement < 1.0 || t.p_reference < 1.0)
+    {
+        let c = &t.counts;
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} / {} / {} / {} | {:.0} % |",
+            t.world_index,
+            t.pair,
+            t.reference.name(),
+            c.success,
+            c.stuck,
+            c.rollover,
+            c.timeout + c.error,
+            100.0 * t.p_reference
+        );
+    }
 }
 
 /// Outcome of the reference (rows) against verti's (columns), over all tasks.

@@ -282,6 +282,9 @@ pub struct Summary {
     /// All tasks first, then each elevation level present.
     pub groups: Vec<Aggregate>,
     pub tasks: Vec<TaskComparison>,
+    /// Each task re-run from jittered starts (`--ensemble`), when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ensemble: Option<crate::ensemble::Ensemble>,
 }
 
 /// Aggregates task comparisons (all of them, then per level).
@@ -300,6 +303,7 @@ pub fn summarize(setup: &CompareSetup, engine: &str, tasks: Vec<TaskComparison>)
         setup: SetupRecord::of(setup),
         groups,
         tasks,
+        ensemble: None,
     }
 }
 
