@@ -91,7 +91,12 @@ fn two_tasks_rerun_and_compare() {
         })
         .collect();
     for c in &comparisons {
-        // both engines start at the same place on the same path: early divergence is small
+        assert!(c.early.common_samples > 0 && c.early.common_samples <= c.early.samples);
+    }
+    // both engines start at the same place on the same path: on the low-elevation task, where
+    // nothing tips or stops, the early divergence is small (the high one ends in a rollover
+    // within seconds, which throws the vehicle sideways in either engine)
+    for c in comparisons.iter().filter(|c| c.world_index == 9) {
         assert!(
             c.early.mean_lateral < 2.0,
             "{} pair {}: {:?}",
@@ -99,7 +104,6 @@ fn two_tasks_rerun_and_compare() {
             c.pair,
             c.early
         );
-        assert!(c.early.common_samples > 0 && c.early.common_samples <= c.early.samples);
     }
     let s = summarize(&setup, &reference.tasks[0].outcome.engine, comparisons);
     assert_eq!(s.groups[0].tasks, 2);

@@ -316,7 +316,7 @@ pub(crate) fn static_slip(fx: f64, fy: f64, tyre: &TyreSpec) -> (f64, f64) {
 /// the force is μ·N in the same direction. So a braked vehicle on a slope holds with a fixed
 /// deflection (k·u = its share of m·g·sin θ, about a millimetre) and never creeps, and a
 /// sliding one feels exactly μ·N. The spring stands in for NSC's exact stick; its period is
-/// the normal contact's (`vehicles/hmmwv-rigid.yaml` derives it from the step).
+/// the normal contact's (`vehicles/hmmwv.yaml` derives it from the step).
 ///
 /// The deflection is updated with the velocity before the force is applied (symplectic Euler,
 /// position first), and along the wheel it is implicit in the new spin rate ω, which the spin

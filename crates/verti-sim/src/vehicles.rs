@@ -6,9 +6,13 @@ use crate::spec::VehicleSpec;
 
 /// (name, YAML text) of every built-in vehicle, in display order.
 const BUILTINS: &[(&str, &str)] = &[
+    // Verti-Bench's configuration: rigid tyres
     ("hmmwv", include_str!("../vehicles/hmmwv.yaml")),
-    // the same HMMWV on Chrono's rigid tyres (Verti-Bench's configuration)
-    ("hmmwv-rigid", include_str!("../vehicles/hmmwv-rigid.yaml")),
+    // the same HMMWV on compliant handling tyres
+    (
+        "hmmwv-handling",
+        include_str!("../vehicles/hmmwv-handling.yaml"),
+    ),
     ("artcar", include_str!("../vehicles/artcar.yaml")),
     ("verti4", include_str!("../vehicles/verti4.yaml")),
     ("truck6", include_str!("../vehicles/truck6.yaml")),

@@ -14,7 +14,7 @@ fn builtin_vehicles_load_and_unknown_names_list_the_known_ones() {
         names,
         [
             "hmmwv",
-            "hmmwv-rigid",
+            "hmmwv-handling",
             "artcar",
             "verti4",
             "truck6",

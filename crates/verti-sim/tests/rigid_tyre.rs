@@ -1,4 +1,4 @@
-//! Validation of the rigid tyre (`tyre.model: rigid`, the built-in `hmmwv-rigid`): a rigid
+//! Validation of the rigid tyre (`tyre.model: rigid`, the built-in `hmmwv`): a rigid
 //! cylinder with Coulomb friction, as Chrono's `ChRigidTire` under NSC contact. Every expected
 //! number is derived on paper from the vehicle file (see the comment above each test); the
 //! tolerance is stated in the test.
@@ -13,7 +13,7 @@ use verti_world::{SoilParams, World};
 const G: f64 = 9.81;
 
 fn rigid() -> VehicleSpec {
-    vehicles::builtin("hmmwv-rigid").unwrap()
+    vehicles::builtin("hmmwv").unwrap()
 }
 
 fn sim_at(world: World, spec: &VehicleSpec, x: f64, y: f64, yaw: f64) -> (Sim, SimState) {
@@ -43,12 +43,12 @@ fn wheel_loads(spec: &VehicleSpec) -> (f64, f64) {
 
 // The preset is the HMMWV of Verti-Bench on Chrono's rigid tyres (physics_spec §2.4): R 0.467,
 // W 0.254, μ 0.9, the tyre's 37.6 kg inside the unsprung mass, no rolling resistance, and
-// everything but the tyre identical to `hmmwv`. Its contact constants are the file's
+// everything but the tyre identical to `hmmwv-handling`. Its contact constants are the file's
 // derivation: k = (m_total / 4)·(0.3 / h)², c = 2·√(k·m_unsprung), within 0.1 % (rounding).
 #[test]
 fn preset_matches_the_reference_configuration_and_its_derivation() {
     let spec = rigid();
-    let base = vehicles::builtin("hmmwv").unwrap();
+    let base = vehicles::builtin("hmmwv-handling").unwrap();
     assert_eq!(spec.tyre.model, TyreModel::Rigid);
     assert_eq!(base.tyre.model, TyreModel::Handling);
     for ax in &spec.axles {
@@ -60,7 +60,7 @@ fn preset_matches_the_reference_configuration_and_its_derivation() {
     same.name = base.name.clone();
     same.description = base.description.clone();
     same.tyre = base.tyre;
-    assert_eq!(same, base, "only the tyre may differ from hmmwv");
+    assert_eq!(same, base, "only the tyre may differ from hmmwv-handling");
     let h = spec.internal_step;
     let k = 0.25 * spec.total_mass() * (0.3 / h).powi(2);
     let c = 2.0 * (k * spec.axles[0].wheel.unsprung_mass).sqrt();
@@ -227,7 +227,7 @@ fn a_wheel_driven_into_a_step_meets_its_face() {
     let height = 0.3;
     let r: f64 = 0.467;
     let touch = face - (r * r - (r - height) * (r - height)).sqrt();
-    for name in ["hmmwv-rigid", "hmmwv"] {
+    for name in ["hmmwv", "hmmwv-handling"] {
         let spec = vehicles::builtin(name).unwrap();
         let (sim, mut st) = sim_at(
             testing::rock_world(1.0, 0.8, face, Vec3::new(3.0, 4.0, height)),
@@ -250,7 +250,7 @@ fn a_wheel_driven_into_a_step_meets_its_face() {
              final speed {:.3} m/s",
             st.forward_speed()
         );
-        if name == "hmmwv-rigid" {
+        if name == "hmmwv" {
             assert!(touched, "the wheels never touched the step");
             assert!(
                 furthest < touch + 0.05,

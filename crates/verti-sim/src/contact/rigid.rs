@@ -4,7 +4,7 @@
 //! Chrono solves that contact as a complementarity constraint (NSC). This engine is penalty
 //! based, so each contact is a stiff spring-damper along the contact normal; the stiffness and
 //! damping are the tyre's `radial_stiffness` and `radial_damping` (the vehicle file derives
-//! them from the internal step, see `vehicles/hmmwv-rigid.yaml`).
+//! them from the internal step, see `vehicles/hmmwv.yaml`).
 //!
 //! Where the cylinder meets things:
 //! * **Terrain** (the heightfield's triangles): along the tread's centre circle, the point
@@ -442,7 +442,7 @@ mod tests {
 
     /// The rigid HMMWV's front-left wheel at rest at `hub`, upright, axle along +y.
     fn touch(world: verti_world::World, hub: Vec3) -> (WheelContact, RigidContact, f64) {
-        let spec = crate::vehicles::builtin("hmmwv-rigid").unwrap();
+        let spec = crate::vehicles::builtin("hmmwv").unwrap();
         let model = Model::compile(&spec, 1.0);
         let terrain = Terrain::new(&Arc::new(world), model.reach).unwrap();
         let mut soil = SoilState::new(terrain.soil.as_ref());
