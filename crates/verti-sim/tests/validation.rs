@@ -10,8 +10,10 @@ use verti_world::{SoilParams, World};
 
 const G: f64 = 9.81;
 
+/// The HMMWV on the handling tyre, which these derivations are written for (the rigid tyre,
+/// the built-in `hmmwv`, has its own in `rigid_tyre.rs`).
 fn hmmwv() -> VehicleSpec {
-    vehicles::builtin("hmmwv").unwrap()
+    vehicles::builtin("hmmwv-handling").unwrap()
 }
 
 fn sim_at(world: World, spec: &VehicleSpec, x: f64, y: f64, yaw: f64) -> (Sim, SimState) {
