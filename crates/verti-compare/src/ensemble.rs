@@ -19,7 +19,7 @@
 //! any number of jobs.
 
 use crate::error::{CompareError, Result};
-use crate::run::{CompareSetup, run_task};
+use crate::run::{CompareSetup, pool, run_task};
 use crate::summary::OutcomeCounts;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -117,14 +117,10 @@ pub fn run_ensemble(
             "an ensemble needs at least 2 members and a positive jitter (got {members} and {jitter} m)"
         )));
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs.max(1))
-        .build()
-        .map_err(|e| CompareError::Argument(format!("cannot start {jobs} threads: {e}")))?;
     let jobs_list: Vec<(usize, u64)> = (0..tasks.len())
         .flat_map(|i| (1..members as u64).map(move |k| (i, k)))
         .collect();
-    let outcomes: Vec<Outcome> = pool.install(|| {
+    let outcomes: Vec<Outcome> = pool(jobs)?.install(|| {
         jobs_list
             .par_iter()
             .map(|&(i, k)| {
@@ -164,24 +160,6 @@ pub fn run_ensemble(
     })
 }
 
-fn share(counts: &OutcomeCounts, o: Outcome) -> usize {
-    match o {
-        Outcome::Success => counts.success,
-        Outcome::Stuck => counts.stuck,
-        Outcome::Rollover => counts.rollover,
-        Outcome::Timeout => counts.timeout,
-        Outcome::Error => counts.error,
-    }
-}
-
-const ALL: [Outcome; 5] = [
-    Outcome::Success,
-    Outcome::Stuck,
-    Outcome::Rollover,
-    Outcome::Timeout,
-    Outcome::Error,
-];
-
 /// One task's shares from its counts over `members` runs.
 pub fn task_stats(
     world_index: u32,
@@ -192,16 +170,16 @@ pub fn task_stats(
     members: usize,
 ) -> EnsembleTask {
     let n = members as f64;
-    let self_agreement = ALL
+    let self_agreement = Outcome::ALL
         .iter()
-        .map(|&o| (share(&counts, o) as f64 / n).powi(2))
+        .map(|&o| (counts.get(o) as f64 / n).powi(2))
         .sum();
     EnsembleTask {
         world_index,
         pair,
         level,
         reference,
-        p_reference: share(&counts, reference) as f64 / n,
+        p_reference: counts.get(reference) as f64 / n,
         self_agreement,
         counts,
     }
@@ -216,14 +194,14 @@ pub fn group(name: &str, tasks: Vec<&EnsembleTask>) -> EnsembleGroup {
     let mut settled_agreeing = 0;
     for t in &tasks {
         reference.add(t.reference);
-        let m: usize = ALL.iter().map(|&o| share(&t.counts, o)).sum();
-        let p = |o| share(&t.counts, o) as f64 / m as f64;
+        let m: usize = Outcome::ALL.iter().map(|&o| t.counts.get(o)).sum();
+        let p = |o| t.counts.get(o) as f64 / m as f64;
         expected.success += p(Outcome::Success);
         expected.stuck += p(Outcome::Stuck);
         expected.rollover += p(Outcome::Rollover);
         expected.timeout += p(Outcome::Timeout);
         expected.error += p(Outcome::Error);
-        if ALL.iter().any(|&o| share(&t.counts, o) == m) {
+        if Outcome::ALL.iter().any(|&o| t.counts.get(o) == m) {
             settled_tasks += 1;
             if t.p_reference == 1.0 {
                 settled_agreeing += 1;

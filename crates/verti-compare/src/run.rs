@@ -220,11 +220,7 @@ pub fn run_tasks(
             return Err(CompareError::Argument(format!("world {w} was not loaded")));
         }
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs.max(1))
-        .build()
-        .map_err(|e| CompareError::Argument(format!("cannot start {jobs} threads: {e}")))?;
-    Ok(pool.install(|| {
+    Ok(pool(jobs)?.install(|| {
         tasks
             .par_iter()
             .map(|&(w, pair)| {
@@ -234,6 +230,14 @@ pub fn run_tasks(
             })
             .collect()
     }))
+}
+
+/// A pool of `jobs` worker threads (at least one) for the trials.
+pub(crate) fn pool(jobs: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.max(1))
+        .build()
+        .map_err(|e| CompareError::Argument(format!("cannot start {jobs} threads: {e}")))
 }
 
 /// Samples of a step log every `period` seconds (the first step at or after each multiple), as

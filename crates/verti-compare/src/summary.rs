@@ -124,6 +124,17 @@ impl OutcomeCounts {
             Outcome::Error => self.error += 1,
         }
     }
+
+    /// How many trials ended as `o`.
+    pub fn get(&self, o: Outcome) -> usize {
+        match o {
+            Outcome::Success => self.success,
+            Outcome::Stuck => self.stuck,
+            Outcome::Rollover => self.rollover,
+            Outcome::Timeout => self.timeout,
+            Outcome::Error => self.error,
+        }
+    }
 }
 
 /// One quantity of both engines over a group of tasks.
