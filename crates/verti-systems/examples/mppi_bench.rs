@@ -8,7 +8,7 @@ use verti_bench::MobilitySystem;
 use verti_bench::observation::test_observation;
 use verti_bench::task_info;
 use verti_systems::mppi::{Mppi, MppiParams};
-use verti_world::generate::{SetConfig, generate_set};
+use verti_world::generate::{SetConfig, generate_set, one_default_world};
 
 fn main() {
     let args: Vec<usize> = std::env::args()
@@ -52,17 +52,7 @@ fn main() {
         }
     }
     // the obstacle crop alone, as MPPI takes it (radius ~ 1.5 v T + 2 m at 0.4 m)
-    let w = Arc::new(
-        generate_set(
-            &SetConfig {
-                count: 1,
-                ..Default::default()
-            },
-            &|| {},
-        )
-        .unwrap()
-        .remove(0),
-    );
+    let w = Arc::new(one_default_world().unwrap());
     let info = task_info(&w, &spec, 0, &Default::default()).unwrap();
     let obs = test_observation(
         &w,

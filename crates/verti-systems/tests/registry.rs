@@ -12,7 +12,7 @@ use verti_bench::{
 };
 use verti_core::Factory;
 use verti_world::World;
-use verti_world::generate::{SetConfig, generate_set};
+use verti_world::generate::one_default_world;
 
 /// Drives at a fixed speed and a steering read from a "weights" file.
 struct Scripted {
@@ -101,15 +101,7 @@ fn an_outside_system_registers_and_builds_with_string_and_path_parameters() {
     assert_eq!(given[1].1, ParamValue::Path(weights.clone()));
     let mut sys = r.create("scripted", &given).unwrap();
     assert_eq!(sys.name(), "toy");
-    let w = generate_set(
-        &SetConfig {
-            count: 1,
-            ..Default::default()
-        },
-        &|| {},
-    )
-    .unwrap()
-    .remove(0);
+    let w = one_default_world().unwrap();
     let obs = verti_bench::observation::test_observation(&w, [0.0, 0.0], 0.0, [10.0, 0.0], &[]);
     assert_eq!(
         sys.act(&obs),
@@ -183,17 +175,7 @@ fn setup<'a>(
 #[test]
 fn run_json_records_every_parameter_and_resumes_old_and_new_records() {
     let r = registry();
-    let ws: Vec<Arc<World>> = generate_set(
-        &SetConfig {
-            count: 1,
-            ..Default::default()
-        },
-        &|| {},
-    )
-    .unwrap()
-    .into_iter()
-    .map(Arc::new)
-    .collect();
+    let ws: Vec<Arc<World>> = vec![Arc::new(one_default_world().unwrap())];
     let hmmwv = verti_sim::vehicles::builtin("hmmwv").unwrap();
     let dir = tmp("eval");
     let weights = dir.join("steer.txt");

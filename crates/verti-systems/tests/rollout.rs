@@ -12,7 +12,7 @@ use verti_systems::rollout::{
     Rollouts,
 };
 use verti_world::World;
-use verti_world::generate::{SetConfig, generate_set};
+use verti_world::generate::one_default_world;
 
 /// The bicycle with its steering reversed; counts its calls and writes each step's steering
 /// as a channel.
@@ -70,15 +70,7 @@ impl RolloutCost for RightTurns {
 }
 
 fn world() -> World {
-    generate_set(
-        &SetConfig {
-            count: 1,
-            ..Default::default()
-        },
-        &|| {},
-    )
-    .unwrap()
-    .remove(0)
+    one_default_world().unwrap()
 }
 
 /// A task whose goal lies 90° to the vehicle's left, with no global path; plans `n` times from

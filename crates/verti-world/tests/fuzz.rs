@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use verti_world::format::{ELEVATION, LABELS, MANIFEST, load_world, save_world};
 use verti_world::generate::elevation::ProceduralRock;
-use verti_world::generate::{SetConfig, composition, generate_set, generate_world};
+use verti_world::generate::{SetConfig, composition, generate_world, one_default_world};
 use verti_world::import_vb::read_grey_bmp;
 use verti_world::scale::{MAX_SCALE, MIN_SCALE, parse_scale};
 
@@ -17,15 +17,7 @@ use verti_world::scale::{MAX_SCALE, MIN_SCALE, parse_scale};
 fn real_world_files() -> &'static Vec<(&'static str, Vec<u8>)> {
     static FILES: OnceLock<Vec<(&'static str, Vec<u8>)>> = OnceLock::new();
     FILES.get_or_init(|| {
-        let w = generate_set(
-            &SetConfig {
-                count: 1,
-                ..Default::default()
-            },
-            &|| {},
-        )
-        .unwrap()
-        .remove(0);
+        let w = one_default_world().unwrap();
         let dir = case_dir("source");
         save_world(&w, &dir).unwrap();
         let files = [MANIFEST, ELEVATION, LABELS]

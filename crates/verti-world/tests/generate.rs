@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use verti_world::format::{load_set, load_world, save_set, save_world};
-use verti_world::generate::{SetConfig, generate_set};
+use verti_world::generate::{SetConfig, generate_set, one_default_world};
 use verti_world::paths::PlanningGrid;
 use verti_world::{ElevationLevel, ObstacleDensity, TerrainType, World};
 
@@ -225,15 +225,7 @@ fn scaled_sets_scale_every_length() {
 /// the field and the problem.
 #[test]
 fn corrupt_worlds_give_clear_errors() {
-    let w = generate_set(
-        &SetConfig {
-            count: 1,
-            ..Default::default()
-        },
-        &|| {},
-    )
-    .unwrap()
-    .remove(0);
+    let w = one_default_world().unwrap();
     let base = tmp("corrupt");
     save_world(&w, &base).unwrap();
     assert_eq!(load_world(&base).unwrap(), w);

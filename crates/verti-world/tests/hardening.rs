@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use verti_world::World;
 use verti_world::format::{load_world, save_set, save_world};
-use verti_world::generate::{SetConfig, generate_set};
+use verti_world::generate::{SetConfig, generate_set, one_default_world};
 use verti_world::sets::{resolve_set, resolve_world};
 
 fn tmp(name: &str) -> PathBuf {
@@ -17,15 +17,7 @@ fn tmp(name: &str) -> PathBuf {
 }
 
 fn one_world() -> World {
-    generate_set(
-        &SetConfig {
-            count: 1,
-            ..Default::default()
-        },
-        &|| {},
-    )
-    .unwrap()
-    .remove(0)
+    one_default_world().unwrap()
 }
 
 /// Saves `w` to a fresh directory, lets `edit` spoil it, and returns the load error.

@@ -291,6 +291,16 @@ pub fn generate_set(config: &SetConfig, progress: &(dyn Fn() + Sync)) -> Result<
     generate_set_with(config, &ProceduralRock::default(), progress)
 }
 
+/// The world of a one-world set with default settings: a full-scale world generated on its own
+/// in well under a second, for tests, examples and benchmarks.
+pub fn one_default_world() -> Result<World> {
+    let config = SetConfig {
+        count: 1,
+        ..Default::default()
+    };
+    Ok(generate_set(&config, &|| {})?.remove(0))
+}
+
 /// [`generate_set`] with another elevation source (see [`sources`]).
 pub fn generate_set_with(
     config: &SetConfig,
