@@ -2,6 +2,7 @@
 
 mod compare_cmd;
 mod eval_cmd;
+mod learn_cmd;
 mod outputs;
 mod progress;
 mod registries;
@@ -41,6 +42,9 @@ enum Command {
     Replay(eval_cmd::ReplayArgs),
     /// Table I and Fig. 6 (Markdown, HTML, PNG, JSON) from evaluation results.
     Report(eval_cmd::ReportArgs),
+    /// Train the shipped models (needs the `learn` feature: `--features learn`).
+    #[command(subcommand)]
+    Learn(learn_cmd::LearnCommand),
 }
 
 #[derive(Subcommand)]
@@ -77,6 +81,7 @@ fn main() -> ExitCode {
         Command::Eval(a) => eval_cmd::eval(a),
         Command::Replay(a) => eval_cmd::replay(a),
         Command::Report(a) => eval_cmd::report(a),
+        Command::Learn(cmd) => learn_cmd::run(cmd).map_err(Into::into),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,230 @@
+//! `verti learn`: trains the models that ship in `models/`. Training needs burn, which only
+//! builds with the `learn` feature (`cargo build --release -p verti-cli --features learn`), so
+//! the classical benchmark never pays for it; without the feature these commands explain how
+//! to get it.
+
+use clap::{Args, Subcommand};
+use std::path::PathBuf;
+
+#[derive(Subcommand)]
+pub enum LearnCommand {
+    /// Train the SWAE terrain generator (`swae-v1`) on Verti-Bench's 1000 elevation maps.
+    Swae(SwaeArgs),
+    /// Train the local-patch terrain encoder (`patch-v1`) on crops from training worlds.
+    Patch(PatchArgs),
+}
+
+/// Settings shared by the autoencoders (defaults depend on the model).
+#[derive(Args, Clone)]
+pub struct AutoencoderArgs {
+    /// Optimiser steps.
+    #[arg(long)]
+    pub steps: Option<usize>,
+    /// Mini-batch size.
+    #[arg(long)]
+    pub batch: Option<usize>,
+    /// Adam learning rate at the start (cosine decay to --lr-final).
+    #[arg(long)]
+    pub lr: Option<f64>,
+    #[arg(long)]
+    pub lr_final: Option<f64>,
+    /// Channels of the stride-2 convolutions, comma-separated (e.g. 8,16,32,64,128).
+    #[arg(long, value_delimiter = ',')]
+    pub widths: Option<Vec<usize>>,
+    /// Latent dimension.
+    #[arg(long, default_value_t = 64)]
+    pub latent: usize,
+    /// Random projections of the sliced-Wasserstein term.
+    #[arg(long, default_value_t = 200)]
+    pub projections: usize,
+    /// Weight of the sliced-Wasserstein term.
+    #[arg(long)]
+    pub swd_weight: Option<f64>,
+    /// Validate every this many steps.
+    #[arg(long, default_value_t = 100)]
+    pub eval_every: usize,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+#[derive(Args)]
+pub struct SwaeArgs {
+    /// Directory of Verti-Bench's elevation maps (`N.bmp`, 128 x 128).
+    #[arg(long, default_value = "../shared/verti-bench-data/elev_maps")]
+    pub data: PathBuf,
+    /// Model card to write (weights and learning curve beside it).
+    #[arg(long, default_value = "models/swae-v1.yaml")]
+    pub out: PathBuf,
+    /// Share of the maps held out for validation.
+    #[arg(long, default_value_t = 0.1)]
+    pub val_fraction: f64,
+    #[command(flatten)]
+    pub train: AutoencoderArgs,
+}
+
+#[derive(Args)]
+pub struct PatchArgs {
+    /// World set of the training crops (never verti-100).
+    #[arg(long, default_value = "verti-100-s1")]
+    pub worlds: String,
+    /// World set of the validation crops.
+    #[arg(long, default_value = "verti-100-s2")]
+    pub val_worlds: String,
+    /// Validation crops.
+    #[arg(long, default_value_t = 512)]
+    pub val_patches: usize,
+    /// Metres of height difference that map to ±1 at the encoder's input.
+    #[arg(long, default_value_t = 2.0)]
+    pub height_scale: f64,
+    /// Model card to write (weights and learning curve beside it).
+    #[arg(long, default_value = "models/patch-v1.yaml")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub train: AutoencoderArgs,
+}
+
+#[cfg(not(feature = "learn"))]
+pub fn run(_cmd: LearnCommand) -> Result<(), String> {
+    Err("this verti was built without training support; rebuild with the `learn` feature: \
+         cargo build --release -p verti-cli --features learn (adds burn, about 7 minutes on 2 cores)"
+        .into())
+}
+
+#[cfg(feature = "learn")]
+pub use with_burn::run;
+
+#[cfg(feature = "learn")]
+mod with_burn {
+    use super::*;
+    use crate::progress::bar;
+    use verti_learn::commands::{RunSettings, Trained, learn_patch, learn_swae};
+    use verti_learn::patches::PatchSettings;
+    use verti_learn::swae::SwaeConfig;
+
+    fn config(a: &AutoencoderArgs, side: usize, defaults: SwaeConfig) -> SwaeConfig {
+        SwaeConfig {
+            side,
+            widths: a.widths.clone().unwrap_or(defaults.widths),
+            latent: a.latent,
+            steps: a.steps.unwrap_or(defaults.steps),
+            batch: a.batch.unwrap_or(defaults.batch),
+            lr: a.lr.unwrap_or(defaults.lr),
+            lr_final: a.lr_final.unwrap_or(defaults.lr_final),
+            projections: a.projections,
+            swd_weight: a.swd_weight.unwrap_or(defaults.swd_weight),
+            seed: a.seed,
+            eval_every: a.eval_every,
+        }
+    }
+
+    fn command_line() -> String {
+        let args: Vec<String> = std::env::args().skip(1).collect();
+        format!("verti {}", args.join(" "))
+    }
+
+    fn name_of(out: &std::path::Path) -> String {
+        out.file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("model")
+            .to_string()
+    }
+
+    fn report(t: &Trained) {
+        println!("{}", t.network.describe());
+        if let Some(p) = t.report.curve.last() {
+            println!(
+                "final: train loss {:.4}, validation MSE {:.4}, validation sliced W2^2 {:.4}",
+                p.train_loss, p.val_mse, p.val_swd
+            );
+        }
+        for (k, v) in &t.network.card().metrics {
+            println!("  {k}: {v}");
+        }
+        println!(
+            "wrote {} (+ {}), learning curve {}; {:.0} s",
+            t.card_path.display(),
+            t.network.card().weights.file,
+            t.curve_png.display(),
+            t.report.wall_time_s
+        );
+    }
+
+    pub fn run(cmd: LearnCommand) -> Result<(), String> {
+        let device = verti_learn::training_device();
+        let (run, data) = match &cmd {
+            LearnCommand::Swae(a) => (
+                config(
+                    &a.train,
+                    128,
+                    SwaeConfig {
+                        side: 128,
+                        widths: vec![8, 16, 32, 64, 128],
+                        latent: 64,
+                        steps: 3000,
+                        batch: 32,
+                        lr: 1e-3,
+                        lr_final: 1e-5,
+                        projections: 200,
+                        swd_weight: 1.0,
+                        seed: 0,
+                        eval_every: 100,
+                    },
+                ),
+                &a.out,
+            ),
+            LearnCommand::Patch(a) => (
+                config(
+                    &a.train,
+                    64,
+                    SwaeConfig {
+                        side: 64,
+                        widths: vec![8, 16, 32, 64],
+                        latent: 64,
+                        steps: 3000,
+                        batch: 64,
+                        lr: 1e-3,
+                        lr_final: 1e-5,
+                        projections: 200,
+                        swd_weight: 1.0,
+                        seed: 0,
+                        eval_every: 100,
+                    },
+                ),
+                &a.out,
+            ),
+        };
+        let settings = RunSettings {
+            config: run.clone(),
+            name: name_of(data),
+            out: data.clone(),
+            command: command_line(),
+        };
+        let pb = bar(run.steps as u64, "training");
+        let mut progress = |step: usize, loss: f64| {
+            pb.set_position(step as u64);
+            if step % 10 == 0 {
+                pb.set_message(format!("loss {loss:.4}"));
+            }
+        };
+        let trained = match cmd {
+            LearnCommand::Swae(a) => {
+                learn_swae(&settings, &a.data, a.val_fraction, &device, &mut progress)?
+            }
+            LearnCommand::Patch(a) => learn_patch(
+                &settings,
+                &PatchSettings {
+                    train_worlds: a.worlds,
+                    val_worlds: a.val_worlds,
+                    validation_patches: a.val_patches,
+                    height_scale: a.height_scale,
+                    seed: a.train.seed,
+                },
+                &device,
+                &mut progress,
+            )?,
+        };
+        pb.finish_and_clear();
+        report(&trained);
+        Ok(())
+    }
+}

@@ -1,0 +1,71 @@
+//! The model card: a small YAML file beside each weight file that says what the network is
+//! (layers, input and output), how to feed it, what it was trained on, with which seed and
+//! command, how long it took and how well it did. The weights file is raw little-endian f32,
+//! layer by layer (weights, then biases), checked against the card's count and digest.
+
+use crate::layer::{LayerSpec, Shape};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Format version written by this crate.
+pub const CARD_FORMAT: u32 = 1;
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelCard {
+    /// Name used on the command line and in world manifests, e.g. `swae-v1`.
+    pub name: String,
+    pub format: u32,
+    /// One paragraph: what the network does and where it is used.
+    pub summary: String,
+    /// Shape of one input.
+    pub input: Shape,
+    pub layers: Vec<LayerSpec>,
+    /// How inputs are prepared and outputs read (units, scaling, crop geometry).
+    pub normalisation: String,
+    pub weights: WeightsInfo,
+    pub training: TrainingInfo,
+    /// Final metrics, by name (e.g. `val_mse`).
+    #[serde(default)]
+    pub metrics: BTreeMap<String, f64>,
+    /// Named constant vectors the model needs besides its layers (e.g. latent statistics).
+    #[serde(default)]
+    pub constants: BTreeMap<String, Vec<f64>>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WeightsInfo {
+    /// File name, relative to the card.
+    pub file: String,
+    /// Number of f32 values.
+    pub floats: usize,
+    /// FNV-1a 64 of the file's bytes, hexadecimal.
+    pub fnv1a64: String,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainingInfo {
+    /// What the model saw (files, world sets and their seeds).
+    pub data: String,
+    /// The one command that reproduces the weights.
+    pub command: String,
+    pub seed: u64,
+    pub steps: u64,
+    pub wall_time_s: f64,
+    /// verti version (and commit when known) that trained it.
+    pub verti_version: String,
+    /// Optimiser, learning rate, batch size and the like, as text.
+    pub settings: String,
+}
+
+/// FNV-1a, 64 bit: a dependency-free digest to catch truncated or swapped weight files.
+pub fn fnv1a64(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}

@@ -1,0 +1,445 @@
+//! Layers and their forward pass, written as plain loops with a fixed summation order.
+//!
+//! Every output element is a sum whose terms are added in one documented order, with no fused
+//! multiply-add (Rust never contracts `a * b + c`), no threads and no BLAS. The result is
+//! therefore bit-identical on every machine, whatever its SIMD width: LLVM vectorises these
+//! loops only across independent outputs, never by reassociating one output's sum. World
+//! generation relies on this (the SWAE decoder makes terrain that must be byte-identical).
+//!
+//! Weight layouts follow burn's, so a trained burn module exports by copying its tensors:
+//! `Linear` [inputs, outputs]; `Conv2d` [out, in, k, k]; `ConvTranspose2d` [in, out, k, k].
+
+use serde::{Deserialize, Serialize};
+
+/// One layer of a feed-forward network, as written in a model card.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum LayerSpec {
+    /// y = x W + b.
+    Linear {
+        inputs: usize,
+        outputs: usize,
+    },
+    /// Square kernel, zero padding.
+    Conv2d {
+        in_channels: usize,
+        out_channels: usize,
+        kernel: usize,
+        stride: usize,
+        padding: usize,
+    },
+    /// Transposed convolution: output side = (side - 1) stride - 2 padding + kernel + output_padding.
+    ConvTranspose2d {
+        in_channels: usize,
+        out_channels: usize,
+        kernel: usize,
+        stride: usize,
+        padding: usize,
+        output_padding: usize,
+    },
+    Relu,
+    /// max(x, slope x).
+    LeakyRelu {
+        slope: f32,
+    },
+    Tanh,
+    /// Reinterprets a flat vector as [channels, height, width] (row-major, no copy).
+    Reshape {
+        shape: [usize; 3],
+    },
+    /// Reinterprets [channels, height, width] as a flat vector.
+    Flatten,
+}
+
+/// The shape of an activation: a flat vector or [channels, height, width].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Shape {
+    Flat(usize),
+    Image([usize; 3]),
+}
+
+impl Shape {
+    pub fn len(self) -> usize {
+        match self {
+            Shape::Flat(n) => n,
+            Shape::Image([c, h, w]) => c * h * w,
+        }
+    }
+    pub fn is_empty(self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl std::fmt::Display for Shape {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Shape::Flat(n) => write!(f, "[{n}]"),
+            Shape::Image([c, h, w]) => write!(f, "[{c}, {h}, {w}]"),
+        }
+    }
+}
+
+impl LayerSpec {
+    /// Number of parameters (weights, then biases).
+    pub fn parameter_count(&self) -> usize {
+        match *self {
+            LayerSpec::Linear { inputs, outputs } => inputs * outputs + outputs,
+            LayerSpec::Conv2d {
+                in_channels: i,
+                out_channels: o,
+                kernel: k,
+                ..
+            }
+            | LayerSpec::ConvTranspose2d {
+                in_channels: i,
+                out_channels: o,
+                kernel: k,
+                ..
+            } => i * o * k * k + o,
+            _ => 0,
+        }
+    }
+
+    /// The output shape for an input of shape `input`, or why the layer cannot take it.
+    pub fn output_shape(&self, input: Shape) -> Result<Shape, String> {
+        let image = |what: &str| match input {
+            Shape::Image(s) => Ok(s),
+            Shape::Flat(_) => Err(format!("{what} needs an image input, got {input}")),
+        };
+        match *self {
+            LayerSpec::Linear { inputs, outputs } => match input {
+                Shape::Flat(n) if n == inputs => Ok(Shape::Flat(outputs)),
+                _ => Err(format!("linear layer takes [{inputs}], got {input}")),
+            },
+            LayerSpec::Conv2d {
+                in_channels,
+                out_channels,
+                kernel,
+                stride,
+                padding,
+            } => {
+                let [c, h, w] = image("conv2d")?;
+                if c != in_channels {
+                    return Err(format!("conv2d takes {in_channels} channels, got {input}"));
+                }
+                if stride == 0
+                    || kernel == 0
+                    || h + 2 * padding < kernel
+                    || w + 2 * padding < kernel
+                {
+                    return Err(format!(
+                        "conv2d kernel {kernel} stride {stride} padding {padding} does not fit {input}"
+                    ));
+                }
+                let side = |n: usize| (n + 2 * padding - kernel) / stride + 1;
+                Ok(Shape::Image([out_channels, side(h), side(w)]))
+            }
+            LayerSpec::ConvTranspose2d {
+                in_channels,
+                out_channels,
+                kernel,
+                stride,
+                padding,
+                output_padding,
+            } => {
+                let [c, h, w] = image("conv_transpose2d")?;
+                if c != in_channels {
+                    return Err(format!(
+                        "conv_transpose2d takes {in_channels} channels, got {input}"
+                    ));
+                }
+                let side = |n: usize| {
+                    ((n - 1) * stride + kernel + output_padding).checked_sub(2 * padding)
+                };
+                match (stride, side(h), side(w)) {
+                    (1.., Some(oh @ 1..), Some(ow @ 1..)) if h > 0 && w > 0 => {
+                        Ok(Shape::Image([out_channels, oh, ow]))
+                    }
+                    _ => Err(format!(
+                        "conv_transpose2d kernel {kernel} stride {stride} padding {padding} does not fit {input}"
+                    )),
+                }
+            }
+            LayerSpec::Relu | LayerSpec::LeakyRelu { .. } | LayerSpec::Tanh => Ok(input),
+            LayerSpec::Reshape { shape } => {
+                let out = Shape::Image(shape);
+                if out.len() == input.len() {
+                    Ok(out)
+                } else {
+                    Err(format!("cannot reshape {input} to {out}"))
+                }
+            }
+            LayerSpec::Flatten => Ok(Shape::Flat(input.len())),
+        }
+    }
+
+    /// Applies the layer. `params` holds exactly `parameter_count()` values (weights, then
+    /// biases); `input` has the shape `shape` that [`LayerSpec::output_shape`] accepted.
+    pub fn forward(&self, params: &[f32], shape: Shape, input: Vec<f32>) -> Vec<f32> {
+        match *self {
+            LayerSpec::Linear { inputs, outputs } => {
+                let (w, b) = params.split_at(inputs * outputs);
+                linear(w, b, &input)
+            }
+            LayerSpec::Conv2d {
+                in_channels,
+                out_channels,
+                kernel,
+                stride,
+                padding,
+            } => {
+                let Shape::Image([_, h, w]) = shape else {
+                    unreachable!("shape checked when the network was built")
+                };
+                let (wt, b) = params.split_at(in_channels * out_channels * kernel * kernel);
+                conv2d(
+                    &input,
+                    [in_channels, h, w],
+                    wt,
+                    b,
+                    out_channels,
+                    kernel,
+                    stride,
+                    padding,
+                )
+            }
+            LayerSpec::ConvTranspose2d {
+                in_channels,
+                out_channels,
+                kernel,
+                stride,
+                padding,
+                output_padding,
+            } => {
+                let Shape::Image([_, h, w]) = shape else {
+                    unreachable!("shape checked when the network was built")
+                };
+                let (wt, b) = params.split_at(in_channels * out_channels * kernel * kernel);
+                conv_transpose2d(
+                    &input,
+                    [in_channels, h, w],
+                    wt,
+                    b,
+                    out_channels,
+                    kernel,
+                    stride,
+                    padding,
+                    output_padding,
+                )
+            }
+            LayerSpec::Relu => map(input, |x| x.max(0.0)),
+            LayerSpec::LeakyRelu { slope } => map(input, |x| if x >= 0.0 { x } else { slope * x }),
+            LayerSpec::Tanh => map(input, libm::tanhf),
+            LayerSpec::Reshape { .. } | LayerSpec::Flatten => input,
+        }
+    }
+}
+
+fn map(mut v: Vec<f32>, f: impl Fn(f32) -> f32) -> Vec<f32> {
+    for x in &mut v {
+        *x = f(*x);
+    }
+    v
+}
+
+/// y[o] = b[o] + x[0] W[0, o] + x[1] W[1, o] + ... (inputs in ascending order).
+fn linear(w: &[f32], b: &[f32], x: &[f32]) -> Vec<f32> {
+    let outputs = b.len();
+    let mut y = b.to_vec();
+    for (xi, row) in x.iter().zip(w.chunks_exact(outputs)) {
+        for (yo, wio) in y.iter_mut().zip(row) {
+            *yo += xi * wio;
+        }
+    }
+    y
+}
+
+/// Each output is its bias plus the terms in the order (input channel, kernel row, kernel
+/// column), all ascending.
+#[allow(clippy::too_many_arguments)]
+fn conv2d(
+    x: &[f32],
+    [cin, h, w]: [usize; 3],
+    wt: &[f32],
+    b: &[f32],
+    cout: usize,
+    k: usize,
+    stride: usize,
+    pad: usize,
+) -> Vec<f32> {
+    let oh = (h + 2 * pad - k) / stride + 1;
+    let ow = (w + 2 * pad - k) / stride + 1;
+    let mut y = vec![0.0f32; cout * oh * ow];
+    for (o, plane) in y.chunks_exact_mut(oh * ow).enumerate() {
+        plane.fill(b[o]);
+        for i in 0..cin {
+            let xin = &x[i * h * w..(i + 1) * h * w];
+            for ky in 0..k {
+                for kx in 0..k {
+                    let wv = wt[((o * cin + i) * k + ky) * k + kx];
+                    for oy in 0..oh {
+                        let iy = (oy * stride + ky) as isize - pad as isize;
+                        if iy < 0 || iy >= h as isize {
+                            continue;
+                        }
+                        let row = &xin[iy as usize * w..(iy as usize + 1) * w];
+                        let out = &mut plane[oy * ow..(oy + 1) * ow];
+                        for (ox, yv) in out.iter_mut().enumerate() {
+                            let ix = (ox * stride + kx) as isize - pad as isize;
+                            if ix >= 0 && ix < w as isize {
+                                *yv += row[ix as usize] * wv;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    y
+}
+
+/// Transposed convolution as a gather: output (oy, ox) takes input (iy, ix) through kernel tap
+/// (ky, kx) where oy = iy stride - pad + ky. Each output is its bias plus the terms in the
+/// order (input channel, kernel row, kernel column), all ascending.
+#[allow(clippy::too_many_arguments)]
+fn conv_transpose2d(
+    x: &[f32],
+    [cin, h, w]: [usize; 3],
+    wt: &[f32],
+    b: &[f32],
+    cout: usize,
+    k: usize,
+    stride: usize,
+    pad: usize,
+    out_pad: usize,
+) -> Vec<f32> {
+    let oh = (h - 1) * stride + k + out_pad - 2 * pad;
+    let ow = (w - 1) * stride + k + out_pad - 2 * pad;
+    let mut y = vec![0.0f32; cout * oh * ow];
+    for (o, plane) in y.chunks_exact_mut(oh * ow).enumerate() {
+        plane.fill(b[o]);
+        for i in 0..cin {
+            let xin = &x[i * h * w..(i + 1) * h * w];
+            for ky in 0..k {
+                for kx in 0..k {
+                    let wv = wt[((i * cout + o) * k + ky) * k + kx];
+                    for oy in 0..oh {
+                        // oy + pad - ky must be a non-negative multiple of the stride
+                        let ny = oy as isize + pad as isize - ky as isize;
+                        if ny < 0 || ny % stride as isize != 0 {
+                            continue;
+                        }
+                        let iy = (ny / stride as isize) as usize;
+                        if iy >= h {
+                            continue;
+                        }
+                        let row = &xin[iy * w..(iy + 1) * w];
+                        let out = &mut plane[oy * ow..(oy + 1) * ow];
+                        for (ox, yv) in out.iter_mut().enumerate() {
+                            let nx = ox as isize + pad as isize - kx as isize;
+                            if nx >= 0 && nx % stride as isize == 0 {
+                                let ix = (nx / stride as isize) as usize;
+                                if ix < w {
+                                    *yv += row[ix] * wv;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    y
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn linear_matches_a_hand_computation() {
+        // W = [[1, 2], [3, 4], [5, 6]] (3 inputs, 2 outputs), b = [0.5, -1]
+        let spec = LayerSpec::Linear {
+            inputs: 3,
+            outputs: 2,
+        };
+        let p = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 0.5, -1.0];
+        let y = spec.forward(&p, Shape::Flat(3), vec![1.0, 0.0, -1.0]);
+        assert_eq!(y, vec![1.0 - 5.0 + 0.5, 2.0 - 6.0 - 1.0]);
+    }
+
+    #[test]
+    fn conv2d_with_a_centre_tap_kernel_is_the_identity_and_stride_subsamples() {
+        let mut w = vec![0.0; 9];
+        w[4] = 1.0;
+        let p: Vec<f32> = w.into_iter().chain([0.0]).collect();
+        let x: Vec<f32> = (0..16).map(|v| v as f32).collect();
+        let s1 = LayerSpec::Conv2d {
+            in_channels: 1,
+            out_channels: 1,
+            kernel: 3,
+            stride: 1,
+            padding: 1,
+        };
+        assert_eq!(s1.forward(&p, Shape::Image([1, 4, 4]), x.clone()), x);
+        let s2 = LayerSpec::Conv2d {
+            in_channels: 1,
+            out_channels: 1,
+            kernel: 3,
+            stride: 2,
+            padding: 1,
+        };
+        assert_eq!(
+            s2.output_shape(Shape::Image([1, 4, 4])),
+            Ok(Shape::Image([1, 2, 2]))
+        );
+        assert_eq!(
+            s2.forward(&p, Shape::Image([1, 4, 4]), x),
+            vec![0.0, 2.0, 8.0, 10.0]
+        );
+    }
+
+    #[test]
+    fn conv_transpose_is_the_adjoint_of_conv() {
+        // <conv(x), y> = <x, conv_t(y)> for the same weights (no bias): the definition of
+        // the transposed convolution, checked on random-ish values.
+        let (cin, cout, k, s, p) = (2, 3, 3, 2, 1);
+        let n = |i: usize| ((i * 7919 % 101) as f32 - 50.0) / 50.0;
+        let wt: Vec<f32> = (0..cout * cin * k * k).map(n).collect();
+        let x: Vec<f32> = (0..cin * 6 * 6).map(|i| n(i + 13)).collect();
+        let cx = conv2d(&x, [cin, 6, 6], &wt, &[0.0; 3], cout, k, s, p);
+        let y: Vec<f32> = (0..cx.len()).map(|i| n(i + 31)).collect();
+        // conv weights [out, in, k, k] read as a transposed conv from `cout` to `cin`
+        // channels are [in = cout, out = cin, k, k]: the same array
+        let ty = conv_transpose2d(&y, [cout, 3, 3], &wt, &[0.0; 2], cin, k, s, p, 1);
+        assert_eq!(ty.len(), x.len());
+        let lhs: f64 = cx.iter().zip(&y).map(|(a, b)| f64::from(a * b)).sum();
+        let rhs: f64 = x.iter().zip(&ty).map(|(a, b)| f64::from(a * b)).sum();
+        assert!((lhs - rhs).abs() < 1e-4, "{lhs} vs {rhs}");
+    }
+
+    #[test]
+    fn shapes_are_checked_with_clear_messages() {
+        let l = LayerSpec::Linear {
+            inputs: 4,
+            outputs: 2,
+        };
+        assert!(l.output_shape(Shape::Flat(3)).unwrap_err().contains("[4]"));
+        let r = LayerSpec::Reshape { shape: [2, 2, 2] };
+        assert_eq!(r.output_shape(Shape::Flat(8)), Ok(Shape::Image([2, 2, 2])));
+        assert!(r.output_shape(Shape::Flat(7)).is_err());
+        let t = LayerSpec::ConvTranspose2d {
+            in_channels: 4,
+            out_channels: 2,
+            kernel: 3,
+            stride: 2,
+            padding: 1,
+            output_padding: 1,
+        };
+        assert_eq!(
+            t.output_shape(Shape::Image([4, 4, 4])),
+            Ok(Shape::Image([2, 8, 8]))
+        );
+    }
+}

@@ -1,0 +1,26 @@
+//! verti's learned models at inference time, without a learning framework.
+//!
+//! Training happens in `verti-learn` (burn); what the benchmark needs to *run* a trained model
+//! lives here, in plain Rust, so that world generation, evaluation and the Python package never
+//! build burn:
+//!
+//! * [`Network`]: feed-forward networks (linear, conv, transposed conv, activations) read from
+//!   a model card ([`ModelCard`], YAML) and a raw f32 weight file, evaluated with fixed-order
+//!   loops that give bit-identical results on every machine;
+//! * [`swae`]: the `swae-v1` elevation source (terrain from the trained SWAE decoder);
+//! * [`patch`]: the local-patch terrain encoder used by learned systems;
+//! * [`shipped`]: the trained models that ship in the repository (`models/`).
+
+pub mod card;
+pub mod layer;
+pub mod network;
+pub mod patch;
+pub mod resize;
+// pub mod shipped;
+pub mod swae;
+
+pub use card::{ModelCard, TrainingInfo, WeightsInfo};
+pub use layer::{LayerSpec, Shape};
+pub use network::{ModelError, Network};
+pub use patch::PatchEncoder;
+pub use swae::{SWAE_SOURCE, SwaeSource};

@@ -1,0 +1,224 @@
+//! A feed-forward network built from a model card and its weights.
+
+use crate::card::{CARD_FORMAT, ModelCard, WeightsInfo, fnv1a64};
+use crate::layer::{LayerSpec, Shape};
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum ModelError {
+    #[error("{path}: {message}")]
+    Invalid { path: PathBuf, message: String },
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// A network ready for inference: the card, and each layer's parameters and input shape.
+#[derive(Clone, Debug)]
+pub struct Network {
+    card: ModelCard,
+    /// Parameters of every layer, concatenated in layer order.
+    params: Vec<f32>,
+    /// (offset into `params`, input shape) per layer.
+    layout: Vec<(usize, Shape)>,
+    output: Shape,
+}
+
+impl Network {
+    /// Builds a network from a card and the bytes of its weight file. `origin` names the card
+    /// in error messages.
+    pub fn from_bytes(
+        card: ModelCard,
+        weights: &[u8],
+        origin: &Path,
+    ) -> Result<Network, ModelError> {
+        let bad = |message: String| ModelError::Invalid {
+            path: origin.to_path_buf(),
+            message,
+        };
+        if card.format != CARD_FORMAT {
+            return Err(bad(format!(
+                "field format: version {} is not supported (this verti reads {CARD_FORMAT})",
+                card.format
+            )));
+        }
+        let mut layout = Vec::with_capacity(card.layers.len());
+        let mut shape = card.input;
+        let mut offset = 0;
+        for (i, layer) in card.layers.iter().enumerate() {
+            layout.push((offset, shape));
+            offset += layer.parameter_count();
+            shape = layer
+                .output_shape(shape)
+                .map_err(|e| bad(format!("field layers[{i}]: {e}")))?;
+        }
+        if offset != card.weights.floats {
+            return Err(bad(format!(
+                "field weights.floats: the layers have {offset} parameters, the card says {}",
+                card.weights.floats
+            )));
+        }
+        if weights.len() != 4 * offset {
+            return Err(bad(format!(
+                "weights file {} has {} bytes, expected {} ({} f32 values): truncated or not this model's",
+                card.weights.file,
+                weights.len(),
+                4 * offset,
+                offset
+            )));
+        }
+        let digest = format!("{:016x}", fnv1a64(weights));
+        if digest != card.weights.fnv1a64 {
+            return Err(bad(format!(
+                "weights file {} has digest {digest}, the card says {}: the file does not belong to this card",
+                card.weights.file, card.weights.fnv1a64
+            )));
+        }
+        let params: Vec<f32> = weights
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        if let Some(k) = params.iter().position(|v| !v.is_finite()) {
+            return Err(bad(format!(
+                "weights file {} holds a non-finite value at index {k}",
+                card.weights.file
+            )));
+        }
+        Ok(Network {
+            card,
+            params,
+            layout,
+            output: shape,
+        })
+    }
+
+    /// Loads `card_path` (YAML) and the weight file it names (relative to the card).
+    pub fn load(card_path: &Path) -> Result<Network, ModelError> {
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| ModelError::Io { path, source }
+        };
+        let text = std::fs::read_to_string(card_path).map_err(io(card_path))?;
+        let card = parse_card(&text, card_path)?;
+        let weights_path = card_path
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join(&card.weights.file);
+        let bytes = std::fs::read(&weights_path).map_err(io(&weights_path))?;
+        Network::from_bytes(card, &bytes, card_path)
+    }
+
+    /// Builds a network from parameters in memory (training code exports this way), filling
+    /// in the card's weight count and digest.
+    pub fn from_params(mut card: ModelCard, params: &[f32]) -> Result<Network, ModelError> {
+        let bytes = params_to_bytes(params);
+        card.weights = WeightsInfo {
+            file: card.weights.file.clone(),
+            floats: params.len(),
+            fnv1a64: format!("{:016x}", fnv1a64(&bytes)),
+        };
+        Network::from_bytes(card, &bytes, Path::new("<in memory>"))
+    }
+
+    /// Writes the card to `card_path` and the weights beside it under the card's file name.
+    pub fn save(&self, card_path: &Path) -> Result<(), ModelError> {
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| ModelError::Io { path, source }
+        };
+        let dir = card_path.parent().unwrap_or(Path::new("."));
+        if !dir.as_os_str().is_empty() {
+            std::fs::create_dir_all(dir).map_err(io(dir))?;
+        }
+        let weights_path = dir.join(&self.card.weights.file);
+        std::fs::write(&weights_path, params_to_bytes(&self.params)).map_err(io(&weights_path))?;
+        let text = serde_norway::to_string(&self.card).map_err(|e| ModelError::Invalid {
+            path: card_path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        std::fs::write(card_path, text).map_err(io(card_path))
+    }
+
+    pub fn card(&self) -> &ModelCard {
+        &self.card
+    }
+    pub fn card_mut(&mut self) -> &mut ModelCard {
+        &mut self.card
+    }
+    pub fn input_shape(&self) -> Shape {
+        self.card.input
+    }
+    pub fn output_shape(&self) -> Shape {
+        self.output
+    }
+    /// All parameters, layer by layer.
+    pub fn params(&self) -> &[f32] {
+        &self.params
+    }
+    /// Size of the weight file, bytes.
+    pub fn weight_bytes(&self) -> usize {
+        4 * self.params.len()
+    }
+
+    /// Runs one input through the network. Panics if `input` does not have the card's input
+    /// length (a programming error: callers build inputs of the declared shape).
+    pub fn forward(&self, input: &[f32]) -> Vec<f32> {
+        assert_eq!(
+            input.len(),
+            self.card.input.len(),
+            "{} takes {} inputs",
+            self.card.name,
+            self.card.input
+        );
+        let mut x = input.to_vec();
+        for (layer, &(offset, shape)) in self.card.layers.iter().zip(&self.layout) {
+            let n = layer.parameter_count();
+            x = layer.forward(&self.params[offset..offset + n], shape, x);
+        }
+        x
+    }
+
+    /// The parameters of layer `index` (weights, then biases).
+    pub fn layer_params(&self, index: usize) -> &[f32] {
+        let (offset, _) = self.layout[index];
+        &self.params[offset..offset + self.card.layers[index].parameter_count()]
+    }
+
+    /// Number of layers of each kind, for summaries.
+    pub fn describe(&self) -> String {
+        let convs = self
+            .card
+            .layers
+            .iter()
+            .filter(|l| {
+                matches!(
+                    l,
+                    LayerSpec::Conv2d { .. } | LayerSpec::ConvTranspose2d { .. }
+                )
+            })
+            .count();
+        format!(
+            "{}: {} -> {}, {} layers ({convs} convolutional), {} parameters ({:.1} KiB)",
+            self.card.name,
+            self.card.input,
+            self.output,
+            self.card.layers.len(),
+            self.params.len(),
+            self.weight_bytes() as f64 / 1024.0
+        )
+    }
+}
+
+/// Parses a card, naming the file and the problem.
+pub fn parse_card(text: &str, path: &Path) -> Result<ModelCard, ModelError> {
+    serde_norway::from_str(text).map_err(|e| ModelError::Invalid {
+        path: path.to_path_buf(),
+        message: format!("not a model card: {e}"),
+    })
+}
+
+fn params_to_bytes(params: &[f32]) -> Vec<u8> {
+    params.iter().flat_map(|v| v.to_le_bytes()).collect()
+}
