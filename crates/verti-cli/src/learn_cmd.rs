@@ -200,10 +200,20 @@ mod with_burn {
             command: command_line(),
         };
         let pb = bar(run.steps as u64, "training");
+        // without a terminal (logs, CI) the bar is hidden: print a line now and then instead
+        let quiet = !std::io::IsTerminal::is_terminal(&std::io::stderr());
+        let started = std::time::Instant::now();
         let mut progress = |step: usize, loss: f64| {
             pb.set_position(step as u64);
             if step % 10 == 0 {
                 pb.set_message(format!("loss {loss:.4}"));
+            }
+            if quiet && (step % run.eval_every == 0 || step == run.steps) {
+                eprintln!(
+                    "step {step}/{}: loss {loss:.4} ({:.0} s)",
+                    run.steps,
+                    started.elapsed().as_secs_f64()
+                );
             }
         };
         let trained = match cmd {

@@ -95,6 +95,41 @@ impl fmt::Display for SetStats {
             )?;
         }
 
+        if self.elevation.iter().any(|e| e.shape.is_some()) {
+            writeln!(
+                f,
+                "\nterrain shape (mean over worlds; fractions of the level's ceiling)"
+            )?;
+            writeln!(
+                f,
+                "  {:<6} {:>10} {:>9} {:>9} {:>7} {:>9} {:>9} {:>9}",
+                "level",
+                "slope p95",
+                "ac lag 1",
+                "ac lag 2",
+                "skew",
+                "kurtosis",
+                "mean/max",
+                "std/max"
+            )?;
+            for e in &self.elevation {
+                if let Some(s) = e.shape {
+                    writeln!(
+                        f,
+                        "  {:<6} {:>9.1}° {:>9.2} {:>9.2} {:>7.2} {:>9.1} {:>9.2} {:>9.3}",
+                        e.level,
+                        s.slope_p95_deg,
+                        s.autocorr_lag1,
+                        s.autocorr_lag2,
+                        s.skewness,
+                        s.kurtosis,
+                        s.mean_fraction,
+                        s.std_fraction
+                    )?;
+                }
+            }
+        }
+
         writeln!(f, "\nterrain classes")?;
         writeln!(
             f,

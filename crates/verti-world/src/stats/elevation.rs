@@ -32,6 +32,64 @@ pub struct LevelElevation {
     pub relief: Option<Summary>,
     /// Per-world standard deviation of height, metres.
     pub world_std: Option<Summary>,
+    /// Mean over worlds of the terrain-shape figures (worlds with at least 9 vertices per
+    /// side; `None` without such worlds).
+    pub shape: Option<LevelShape>,
+}
+
+/// Terrain-shape figures of one level, each the mean over its worlds: what the README's
+/// fidelity table compares between elevation sources and the Verti-Bench worlds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct LevelShape {
+    /// 95th percentile of the vertex slope, degrees (central differences).
+    pub slope_p95_deg: f64,
+    /// Autocorrelation of heights along rows at lags of 1 and 2 vertices.
+    pub autocorr_lag1: f64,
+    pub autocorr_lag2: f64,
+    pub skewness: f64,
+    pub kurtosis: f64,
+    /// Mean and standard deviation of heights as fractions of the level's ceiling.
+    pub mean_fraction: f64,
+    pub std_fraction: f64,
+}
+
+/// 95th percentile of the slope (degrees) over the interior vertices of a heightfield.
+fn slope_p95(w: &World) -> f64 {
+    let t = &w.terrain;
+    let (n, cell) = (t.size(), t.cell());
+    let mut slopes = Vec::with_capacity(n * n);
+    for r in 1..n - 1 {
+        for c in 1..n - 1 {
+            let gx = (t.vertex(r, c + 1) - t.vertex(r, c - 1)) / (2.0 * cell);
+            let gy = (t.vertex(r + 1, c) - t.vertex(r - 1, c)) / (2.0 * cell);
+            slopes.push((gx * gx + gy * gy).sqrt().atan().to_degrees());
+        }
+    }
+    slopes.sort_by(f64::total_cmp);
+    slopes[((slopes.len() as f64 * 0.95) as usize).min(slopes.len() - 1)]
+}
+
+fn level_shape(worlds: &[&World]) -> Option<LevelShape> {
+    let usable: Vec<&&World> = worlds.iter().filter(|w| w.terrain.size() >= 9).collect();
+    if usable.is_empty() {
+        return None;
+    }
+    let k = usable.len() as f64;
+    let mut acc = LevelShape::default();
+    for w in usable {
+        let n = w.terrain.size();
+        let ceiling = w.meta.max_height;
+        let fractions: Vec<f64> = w.terrain.heights().iter().map(|h| h / ceiling).collect();
+        let st = crate::generate::elevation::shape_stats(&fractions, n);
+        acc.slope_p95_deg += slope_p95(w) / k;
+        acc.autocorr_lag1 += st.autocorrelation[0] / k;
+        acc.autocorr_lag2 += st.autocorrelation[1] / k;
+        acc.skewness += st.skewness / k;
+        acc.kurtosis += st.kurtosis / k;
+        acc.mean_fraction += st.mean / k;
+        acc.std_fraction += st.std / k;
+    }
+    Some(acc)
 }
 
 pub(super) fn level_elevation(
@@ -91,5 +149,6 @@ pub(super) fn level_elevation(
         std,
         relief: Summary::of(reliefs),
         world_std: Summary::of(stds),
+        shape: level_shape(&mine),
     }
 }
