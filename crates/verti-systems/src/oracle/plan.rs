@@ -183,7 +183,8 @@ pub struct Rollout {
 }
 
 /// Rolls `plan` out on a branch of `trial` over the horizon and scores it: the decrease of the
-/// route's cost-to-go (full-scale metres), a bonus for reaching the goal (earlier is better),
+/// route's cost-to-go (full-scale metres; in effect the planar distance to the goal, see
+/// [`super::route`]), a bonus for reaching the goal (earlier is better),
 /// penalties for failing (rollover, stuck, error), leaving the map or tilting past the lost
 /// roll, a mild quadratic penalty on roll and pitch beyond their soft limits, and a little
 /// for the speed kept at the end (a vehicle that stops on a slope often cannot start again).

@@ -3,9 +3,12 @@
 //!
 //! * a **cost-to-go** `g(x, y) = min_i (|(x, y) − p_i| + L_i)`: the distance to some path point
 //!   plus the path length from there to the goal. Its decrease over a rollout is the rollout's
-//!   progress. Unlike the straight-line distance to the goal it rewards progress around
-//!   obstacles the path goes around, and unlike the arc length of the nearest point it also
-//!   rewards a shortcut or a detour that rejoins the path further on.
+//!   progress. Note: since `L_i` is at least the straight distance from `p_i` to the goal, the
+//!   triangle inequality makes `g` equal (up to rounding) to the planar distance to the goal,
+//!   the minimum being at the goal point itself. The path does not shape the progress term;
+//!   it shapes the candidates (tracking, below). This form is kept because it is what the
+//!   measured defaults ran with (`docs/oracle.md`); a path-shaped progress term (e.g. a
+//!   weight > 1 on the distance to the path point) is untried.
 //! * **tracking**: the steering that aims at a point a lookahead ahead on the path, shifted
 //!   sideways by an offset. Tracking segments let a candidate follow the path (offset 0, what
 //!   PID does) or a parallel lane beside it (offset ≠ 0, around a mound on the path), and they
@@ -101,7 +104,8 @@ impl Route {
         best.1
     }
 
-    /// Cost-to-go from (x, y), metres (see the module doc).
+    /// Cost-to-go from (x, y), metres: equal, up to rounding, to the planar distance to the
+    /// goal (see the module doc).
     pub fn cost_to_go(&self, x: f64, y: f64) -> f64 {
         self.points
             .iter()
@@ -152,10 +156,12 @@ mod tests {
         // an L-shaped path: east 20 m, then north 20 m
         let path = [[0.0, 0.0], [20.0, 0.0], [20.0, 20.0]];
         let r = Route::new(&path, [0.0, 0.0], [20.0, 20.0], 1.0);
-        assert!((r.cost_to_go(0.0, 0.0) - 40.0).abs() < 1e-9);
-        assert!((r.cost_to_go(20.0, 20.0)).abs() < 1e-9);
-        // beside the corner: 2 m to the corner plus 20 m of path
-        assert!((r.cost_to_go(22.0, 0.0) - 22.0).abs() < 1e-9);
+        // the cost-to-go is the straight distance to the goal (triangle inequality), not the
+        // 40 m of path: see the module doc
+        for (x, y) in [(0.0, 0.0), (20.0, 20.0), (22.0, 0.0), (5.0, -7.0)] {
+            let d = ((x - 20.0f64).powi(2) + (y - 20.0f64).powi(2)).sqrt();
+            assert!((r.cost_to_go(x, y) - d).abs() < 1e-9, "({x}, {y})");
+        }
         // at the start facing east: straight ahead is on the path; an offset lane to the left
         // (north) needs a left (positive) turn
         assert!(r.track(0.0, 0.0, 0.0, 5.0, 0.0, 0.5).abs() < 1e-9);
@@ -164,7 +170,7 @@ mod tests {
         // no global path: the straight line to the goal
         let r = Route::new(&[], [0.0, 0.0], [10.0, 0.0], 1.0);
         assert!((r.cost_to_go(0.0, 0.0) - 10.0).abs() < 1e-9);
-        // off the line, the best point is the goal itself: the straight-line distance
+        // off the line too
         assert!((r.cost_to_go(0.0, 3.0) - 109f64.sqrt()).abs() < 1e-9);
     }
 }
