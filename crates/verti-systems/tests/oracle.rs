@@ -174,7 +174,10 @@ fn without_privileged_access_the_oracle_fails_the_trial_with_a_message() {
 
 #[test]
 fn parameters_are_validated() {
-    let bad = |p: OracleParams| Oracle::new(p).err().expect("refused");
+    let bad = |p: OracleParams| match Oracle::new(p) {
+        Ok(_) => panic!("refused"),
+        Err(e) => e,
+    };
     let e = bad(OracleParams {
         horizon: 0.25,
         ..Default::default()

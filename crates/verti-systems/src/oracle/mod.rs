@@ -164,16 +164,17 @@ impl Oracle {
     /// Plans from the running trial: rolls every candidate out and keeps the best.
     fn replan(&mut self, trial: &verti_bench::Trial) {
         let cands = plan::candidates(&self.shape, self.plan.as_ref(), &mut self.rng);
-        let mut best: Option<(f64, usize, Option<(Outcome, usize)>)> = None;
+        // (index, rollout) of the best candidate so far
+        let mut best: Option<(usize, plan::Rollout)> = None;
         for (i, c) in cands.iter().enumerate() {
             let r = plan::rollout(trial, c, &self.shape, &self.ctx);
             self.rollouts += 1;
             // strict comparison: ties go to the earlier candidate (warm start, structured)
-            if best.is_none_or(|(s, _, _)| r.score > s) {
-                best = Some((r.score, i, r.ended));
+            if best.is_none_or(|(_, b)| r.score > b.score) {
+                best = Some((i, r));
             }
         }
-        let (_, i, ended) = best.expect("at least one candidate");
+        let (i, plan::Rollout { ended, .. }) = best.expect("at least one candidate");
         self.committed = matches!(ended, Some((Outcome::Success, _)));
         self.plan = Some(cands[i].clone());
         self.tick = 0;
@@ -191,7 +192,8 @@ impl MobilitySystem for Oracle {
     fn reset(&mut self, task: &TaskInfo) {
         let scale = task.world_scale;
         self.ctx = Context {
-            route: Route::new(&task.global_path, task.start, task.goal, 1.0 * scale),
+            // resampled every metre at full scale
+            route: Route::new(&task.global_path, task.start, task.goal, scale),
             scale,
             lookahead: self.params.lookahead,
             max_steer: task.max_steer_angle,
