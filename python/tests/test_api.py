@@ -156,7 +156,7 @@ def test_sim_rejects_bad_input(world):
 def test_vehicles_and_systems():
     assert "hmmwv" in verti.vehicles()
     names = [s["name"] for s in verti.systems()]
-    assert names == ["pid", "eh", "mppi"]
+    assert names == ["pid", "eh", "mppi", "oracle"]
     pid = verti.systems()[0]
     speed = next(p for p in pid["params"] if p["name"] == "speed")
     assert speed["type"] == "float" and speed["default"] == 3.0 and speed["max"] == 30.0

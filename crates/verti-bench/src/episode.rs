@@ -403,6 +403,10 @@ pub fn run_episode(
     let period = 1.0 / rate;
     loop {
         let action = system.act(&trial.observation());
+        if let Some(message) = system.failure() {
+            trial.abort(format!("system {name} failed: {message}"));
+            break;
+        }
         if trial.step(action, period).ended.is_some() {
             break;
         }

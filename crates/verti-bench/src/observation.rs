@@ -3,8 +3,15 @@
 //!
 //! Crops are computed only when a system asks for them, so a system that needs no map pays
 //! nothing for maps.
+//!
+//! An observation made by a running [`Trial`] also carries the trial itself, reachable through
+//! [`Observation::trial`]. That is *privileged*: a system that uses it plans with the true
+//! simulator, which no deployable system has. Only oracle-type systems (the `oracle` of
+//! verti-systems, an expert demonstrator for datasets) may use it; every system of the paper
+//! sees the fields above only.
 
 use crate::features::FeatureSource;
+use crate::trial::Trial;
 use verti_core::Vec3;
 use verti_sim::Controls;
 use verti_world::World;
@@ -62,6 +69,8 @@ pub struct Observation<'a> {
     /// Length scale of the world.
     pub world_scale: f64,
     vehicle: FeatureSource,
+    /// The trial observed (privileged; see [`Observation::trial`]).
+    trial: Option<&'a Trial>,
 }
 
 impl<'a> Observation<'a> {
@@ -85,7 +94,31 @@ impl<'a> Observation<'a> {
             global_path,
             world_scale: world.meta.scale,
             vehicle,
+            trial: None,
         }
+    }
+
+    /// This observation with privileged access to `trial`, the running trial it describes
+    /// ([`crate::Trial::observation`] sets it; see [`Observation::trial`]).
+    pub fn with_trial(mut self, trial: &'a Trial) -> Self {
+        self.trial = Some(trial);
+        self
+    }
+
+    /// This observation without privileged access (what a system would see outside a trial).
+    pub fn without_trial(mut self) -> Self {
+        self.trial = None;
+        self
+    }
+
+    /// **Privileged.** The running trial this observation was made from: the true simulator
+    /// and world, which a system may clone ([`Trial::clone`], [`Trial::branch`]) and step to
+    /// look ahead. Only oracle-type systems (planners with the true simulator, expert
+    /// demonstrators) may use it; a system compared with the paper's must not. `None` where
+    /// no trial exists: observations built by hand ([`Observation::new`], [`test_observation`])
+    /// or for systems outside a trial (e.g. Python).
+    pub fn trial(&self) -> Option<&'a Trial> {
+        self.trial
     }
 
     /// The vehicle's state as named features (the schema of [`crate::features`]).

@@ -47,6 +47,13 @@ pub trait MobilitySystem: Send {
     fn reset(&mut self, task: &TaskInfo);
     /// Called at the control rate; the action is held until the next call.
     fn act(&mut self, obs: &Observation) -> Action;
+    /// Why the system cannot go on, if it cannot (asked after every `act`): the driver then
+    /// ends the trial as an error with this message instead of applying the action. The
+    /// `oracle` uses it when it is given an observation without privileged access. Default:
+    /// never.
+    fn failure(&self) -> Option<String> {
+        None
+    }
 }
 
 impl Registrable for dyn MobilitySystem {

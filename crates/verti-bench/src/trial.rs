@@ -363,7 +363,8 @@ impl Trial {
         r
     }
 
-    /// The observation a system sees now.
+    /// The observation a system sees now, with privileged access to this trial
+    /// ([`Observation::trial`]; only oracle-type systems may use it).
     pub fn observation(&self) -> Observation<'_> {
         Observation::new(
             &self.world,
@@ -371,6 +372,36 @@ impl Trial {
             self.task.goal,
             &self.info.global_path,
         )
+        .with_trial(self)
+    }
+
+    /// A branch of this trial for looking ahead: a clone without the step log (a planner's
+    /// rollouts need none, and copying a long log per rollout would dominate their cost). The
+    /// branch steps exactly as the trial itself would.
+    pub fn branch(&self) -> Trial {
+        let log = None;
+        Trial {
+            world: self.world.clone(),
+            sim: self.sim.clone(),
+            state: self.state.clone(),
+            task: self.task,
+            info: self.info.clone(),
+            cfg: EpisodeConfig {
+                log_seconds: None,
+                ..self.cfg.clone()
+            },
+            rules: self.rules.clone(),
+            speed: self.speed,
+            pose: self.pose,
+            step_index: self.step_index,
+            next_control: self.next_control,
+            controls: self.controls,
+            result: self.result.clone(),
+            last_xy: self.last_xy,
+            ended: self.ended,
+            log,
+            started: self.started,
+        }
     }
 
     /// The features of the current state (for state vectors and logs).

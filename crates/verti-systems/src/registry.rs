@@ -4,6 +4,7 @@
 
 use crate::eh::{EhParams, ElevationHeuristic};
 use crate::mppi::{Mppi, MppiParams};
+use crate::oracle::{Oracle, OracleParams};
 use crate::pid::{Pid, PidParams};
 use verti_bench::{MobilitySystem, ParamSpec, ParamValue, Params, SystemInfo, SystemRegistry};
 use verti_core::Factory;
@@ -202,18 +203,58 @@ impl Factory<dyn MobilitySystem> for MppiFactory {
     }
 }
 
-/// Adds PID, EH and MPPI to a registry.
+/// The oracle: sampling MPC with the true simulator (privileged).
+pub struct OracleFactory;
+
+impl Factory<dyn MobilitySystem> for OracleFactory {
+    fn info(&self) -> SystemInfo {
+        let d = OracleParams::default();
+        SystemInfo {
+            name: "oracle".into(),
+            summary: "PRIVILEGED upper bound: sampling MPC whose rollouts are branches of the running trial (the true simulator)".into(),
+            params: vec![
+                ParamSpec::int("samples", d.samples as i64, 1, 4096, "candidate plans per replanning instant"),
+                ParamSpec::float("horizon", d.horizon, 0.1, 30.0, "planning horizon, s (a multiple of 0.1 s)"),
+                ParamSpec::int("segments", d.segments as i64, 1, 300, "piecewise-constant segments per plan (horizon / segments: whole 0.1 s ticks)"),
+                ParamSpec::float("replan", d.replan, 0.1, 30.0, "replanning period, s (a multiple of 0.1 s, at most a segment)"),
+                ParamSpec::float("speed", d.speed, 0.1, 30.0, "nominal target speed at full scale, m/s"),
+                ParamSpec::float("min_speed", d.min_speed, 0.1, 30.0, "lowest sampled target speed at full scale, m/s"),
+                ParamSpec::float("max_speed", d.max_speed, 0.1, 30.0, "highest sampled target speed at full scale, m/s"),
+                ParamSpec::float("lane", d.lane, 0.0, 100.0, "lateral offset between route-tracking candidates at full scale, m"),
+                ParamSpec::float("lookahead", d.lookahead, 0.5, 60.0, "route-tracking lookahead at full scale, m"),
+                ParamSpec::float("w_tilt", d.w_tilt, 0.0, 1e3, "weight of the roll/pitch penalty beyond 15 deg / 20 deg"),
+            ],
+        }
+    }
+    fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
+        Ok(Box::new(Oracle::new(OracleParams {
+            samples: p.usize("samples"),
+            horizon: p.float("horizon"),
+            segments: p.usize("segments"),
+            replan: p.float("replan"),
+            speed: p.float("speed"),
+            min_speed: p.float("min_speed"),
+            max_speed: p.float("max_speed"),
+            lane: p.float("lane"),
+            lookahead: p.float("lookahead"),
+            w_tilt: p.float("w_tilt"),
+        })?))
+    }
+}
+
+/// Adds PID, EH, MPPI and the oracle to a registry.
 pub fn register(registry: &mut SystemRegistry) {
     for r in [
         registry.register(PidFactory),
         registry.register(EhFactory),
         registry.register(MppiFactory),
+        registry.register(OracleFactory),
     ] {
         r.expect("the built-in systems are declared correctly and registered once");
     }
 }
 
-/// A registry of the built-in systems only (PID, EH, MPPI).
+/// A registry of the built-in systems only (PID, EH, MPPI, oracle).
 pub fn builtin() -> SystemRegistry {
     let mut r = SystemRegistry::new();
     register(&mut r);

@@ -89,7 +89,7 @@ fn registry() -> SystemRegistry {
 #[test]
 fn an_outside_system_registers_and_builds_with_string_and_path_parameters() {
     let r = registry();
-    assert_eq!(r.names(), ["pid", "eh", "mppi", "scripted"]);
+    assert_eq!(r.names(), ["pid", "eh", "mppi", "oracle", "scripted"]);
     let dir = tmp("build");
     let weights = dir.join("steer.txt");
     std::fs::write(&weights, "0.25\n").unwrap();

@@ -29,6 +29,9 @@ impl MobilitySystem for Cancellable {
         }
         self.inner.act(obs)
     }
+    fn failure(&self) -> Option<String> {
+        self.inner.failure()
+    }
 }
 
 pub(super) fn parse_rules(s: &str) -> PyResult<Rules> {
