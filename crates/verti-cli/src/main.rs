@@ -1,6 +1,7 @@
 //! `verti`: the command line of the verti off-road mobility benchmark.
 
 mod compare_cmd;
+mod data_cmd;
 mod eval_cmd;
 mod outputs;
 mod progress;
@@ -41,6 +42,9 @@ enum Command {
     Replay(eval_cmd::ReplayArgs),
     /// Table I and Fig. 6 (Markdown, HTML, PNG, JSON) from evaluation results.
     Report(eval_cmd::ReportArgs),
+    /// Datasets: random exploration, failure cases and expert demonstrations (Parquet).
+    #[command(subcommand)]
+    Data(data_cmd::DataCommand),
 }
 
 #[derive(Subcommand)]
@@ -77,6 +81,7 @@ fn main() -> ExitCode {
         Command::Eval(a) => eval_cmd::eval(a),
         Command::Replay(a) => eval_cmd::replay(a),
         Command::Report(a) => eval_cmd::report(a),
+        Command::Data(cmd) => data_cmd::run(cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
