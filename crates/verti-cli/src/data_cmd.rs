@@ -15,7 +15,7 @@ use verti_world::World;
 #[derive(Subcommand)]
 pub enum DataCommand {
     /// Generate a dataset: random exploration, failure cases or expert demonstrations.
-    Generate(GenerateArgs),
+    Generate(Box<GenerateArgs>),
     /// Summarise a dataset: hours, trials, outcomes, speed/roll/pitch (and a PNG of histograms).
     Stats(StatsArgs),
 }
@@ -80,7 +80,7 @@ pub struct StatsArgs {
 
 pub fn run(cmd: DataCommand) -> CmdResult {
     match cmd {
-        DataCommand::Generate(a) => generate(a),
+        DataCommand::Generate(a) => generate(*a),
         DataCommand::Stats(a) => print_stats(a),
     }
 }

@@ -139,7 +139,7 @@ impl<'a> WindowSampler<'a> {
             first_rows: first_rows.to_vec(),
         };
         for &first in first_rows {
-            if !self.starts.binary_search(&first).is_ok() {
+            if self.starts.binary_search(&first).is_err() {
                 return Err(DataError::Argument(format!(
                     "row {first} does not start a window of {} steps inside one trial",
                     self.steps
