@@ -33,6 +33,7 @@ from ._verti import (
 )
 from .results import flatten_result, results_table, to_dataframe
 from .envs import NavigateEnv, NavigateVectorEnv, register_envs
+from . import data
 
 register_envs()
 
@@ -50,6 +51,7 @@ __all__ = [
     "VecEnvCore",
     "World",
     "__version__",
+    "data",
     "evaluate",
     "flatten_result",
     "load_worlds",

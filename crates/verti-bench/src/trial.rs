@@ -199,6 +199,73 @@ impl Trial {
         })
     }
 
+    /// Starts a goal-less exploration trial at `start` on `world` (datasets: random driving,
+    /// teleoperation). The same inner loop and rules as a task, but no goal: success never
+    /// happens (the success radius is 0), so the trial ends by rollover, stuck, the time limit
+    /// `cfg.max_time`, or when its driver stops stepping it (e.g. at the map's edge). The
+    /// result's `task` and `pair` are 0; `final_distance` is the distance from the start.
+    pub fn explore(
+        world: &Arc<World>,
+        sim: Arc<Sim>,
+        start: StartPose,
+        cfg: &EpisodeConfig,
+        system: &str,
+    ) -> Result<Trial, String> {
+        cfg.validate()?;
+        // no goal: `planar distance < 0` is never true, so the success rule never fires
+        let cfg = EpisodeConfig {
+            success_radius: 0.0,
+            ..cfg.clone()
+        };
+        let state = match cfg.start {
+            StartMode::Settled => sim.state_at(start),
+            StartMode::Drop => sim.state_dropped(start, StartMode::DROP_HEIGHT * world.meta.scale),
+        }
+        .map_err(|e| format!("cannot start the simulation: {e}"))?;
+        let spec = sim.spec();
+        let here = [start.x, start.y];
+        let task = Task {
+            pair: 0,
+            start: here,
+            goal: here,
+        };
+        let info = TaskInfo {
+            id: world.task_id(0),
+            start: here,
+            goal: here,
+            global_path: Vec::new(),
+            world_scale: world.meta.scale,
+            vehicle: spec.name.clone(),
+            wheelbase: spec.wheelbase(),
+            max_steer_angle: spec.steering.max_angle_deg.to_radians(),
+            max_time: cfg.max_time,
+            seed: cfg.seed,
+        };
+        let pose = pose6(&sim, &state);
+        let rules = Termination::new(world, here, &cfg, &pose);
+        let mut result = blank_result(world, &spec.name, 0, system, &cfg);
+        result.task = 0;
+        Ok(Trial {
+            world: world.clone(),
+            state,
+            task,
+            info,
+            rules,
+            speed: SpeedController::default(),
+            pose,
+            step_index: 0,
+            next_control: 0.0,
+            controls: Controls::IDLE,
+            result,
+            last_xy: (pose.x, pose.y),
+            ended: None,
+            log: cfg.log_seconds.map(|_| EpisodeLog::default()),
+            started: Instant::now(),
+            cfg,
+            sim,
+        })
+    }
+
     /// Builds the vehicle model for `world` and starts the task (see [`Trial::new`]).
     pub fn start(
         world: &Arc<World>,

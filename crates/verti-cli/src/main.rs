@@ -1,6 +1,7 @@
 //! `verti`: the command line of the verti off-road mobility benchmark.
 
 mod compare_cmd;
+mod data_cmd;
 mod eval_cmd;
 mod learn_cmd;
 mod outputs;
@@ -45,6 +46,9 @@ enum Command {
     /// Train the shipped models (needs the `learn` feature: `--features learn`).
     #[command(subcommand)]
     Learn(learn_cmd::LearnCommand),
+    /// Datasets: random exploration, failure cases and expert demonstrations (Parquet).
+    #[command(subcommand)]
+    Data(data_cmd::DataCommand),
 }
 
 #[derive(Subcommand)]
@@ -82,6 +86,7 @@ fn main() -> ExitCode {
         Command::Replay(a) => eval_cmd::replay(a),
         Command::Report(a) => eval_cmd::report(a),
         Command::Learn(cmd) => learn_cmd::run(cmd).map_err(Into::into),
+        Command::Data(cmd) => data_cmd::run(cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -17,7 +17,7 @@ pub fn elevation_sources() -> ElevationRegistry {
     let mut r = ElevationRegistry::new();
     verti_world::generate::sources::register(&mut r);
     // the trained SWAE (`swae-v1`), evaluated without burn
-    // verti_nn::shipped::register_sources(&mut r);
+    verti_nn::shipped::register_sources(&mut r);
     r
 }
 

@@ -16,7 +16,7 @@ pub mod layer;
 pub mod network;
 pub mod patch;
 pub mod resize;
-// pub mod shipped;
+pub mod shipped;
 pub mod swae;
 
 pub use card::{ModelCard, TrainingInfo, WeightsInfo};

@@ -26,7 +26,7 @@ fn swae_terrain_is_bit_identical_to_the_recorded_digest() {
     assert_eq!(format!("{d:016x}"), EXPECTED_SWAE_DIGEST);
 }
 
-const EXPECTED_SWAE_DIGEST: &str = "unset";
+const EXPECTED_SWAE_DIGEST: &str = "16772c62b8186bd2";
 
 #[test]
 fn swae_worlds_do_not_depend_on_the_thread_count() {

@@ -176,6 +176,7 @@ pub(super) fn interruptible<T: Send>(
     outcome.map_err(internal)
 }
 
+mod data;
 mod env;
 mod eval;
 mod pysystem;
@@ -201,6 +202,8 @@ fn verti_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(vehicles, m)?)?;
     m.add_function(wrap_pyfunction!(systems, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(data::_load_dataset, m)?)?;
+    m.add_function(wrap_pyfunction!(data::_generate_dataset, m)?)?;
     m.add("SimulationError", py.get_type::<SimulationError>())?;
     // the feature schema: every feature's name, and the default selections
     m.add("STATE_FIELDS", names_of(&ENV_STATE))?;

@@ -1,0 +1,141 @@
+//! Writing a dataset directory: Parquet step tables in trial order, then `manifest.yaml`.
+
+use crate::generate::{GenerateConfig, Source, generate};
+use crate::manifest::{FORMAT, MANIFEST, Manifest, WorldsInfo, checksum};
+use crate::table::{Table, TrialRecord, write_table};
+use crate::{DataError, Result};
+use std::path::Path;
+use verti_world::WorldSource;
+
+/// Trials per Parquet file (at least; a file closes at the first batch that reaches it).
+pub const FILE_TRIALS: usize = 64;
+
+/// File name of the `n`-th step table.
+pub fn file_name(n: usize) -> String {
+    format!("steps-{n:05}.parquet")
+}
+
+/// What the manifest records beyond the generation settings.
+#[derive(Clone, Debug)]
+pub struct WriteInfo {
+    /// The world set as given (`verti-100-s1`, a directory).
+    pub set: String,
+    /// The set's resolved name.
+    pub set_name: String,
+    /// The command line that made the data.
+    pub command: String,
+    /// Recorded on evaluation worlds (allowed with `--allow-eval-worlds`).
+    pub eval_worlds: bool,
+    /// Replace the dataset files in a non-empty directory.
+    pub force: bool,
+}
+
+/// Refuses a non-empty `dir` unless `force` (then removes the dataset files in it).
+fn prepare_dir(dir: &Path, force: bool) -> Result<()> {
+    if dir.exists() {
+        let entries: Vec<_> = std::fs::read_dir(dir)
+            .map_err(|e| DataError::file(dir, e))?
+            .flatten()
+            .collect();
+        if !entries.is_empty() && !force {
+            return Err(DataError::Argument(format!(
+                "--out {} exists and is not empty; choose another directory or pass --force to replace its dataset",
+                dir.display()
+            )));
+        }
+        for e in entries {
+            let name = e.file_name().to_string_lossy().to_string();
+            let ours = name == MANIFEST
+                || (name.starts_with("steps-")
+                    && (name.ends_with(".parquet") || name.ends_with(".parquet.partial")));
+            if ours {
+                std::fs::remove_file(e.path()).map_err(|err| DataError::file(&e.path(), err))?;
+            }
+        }
+    } else {
+        std::fs::create_dir(dir).map_err(|e| DataError::file(dir, e))?;
+    }
+    Ok(())
+}
+
+/// Generates the dataset `cfg` describes into `dir` and writes its manifest (last, so a
+/// directory without one is an unfinished run). `progress` gets budget seconds as they pass.
+pub fn write_dataset(
+    dir: &Path,
+    cfg: &GenerateConfig,
+    info: &WriteInfo,
+    progress: &dyn Fn(f64),
+) -> Result<Manifest> {
+    cfg.validate()?;
+    prepare_dir(dir, info.force)?;
+    let wheels = cfg.vehicle.wheel_count();
+    let mut files: Vec<(String, String)> = Vec::new();
+    let mut pending: Vec<TrialRecord> = Vec::new();
+    let flush = |pending: &mut Vec<TrialRecord>, files: &mut Vec<(String, String)>| -> Result<()> {
+        if pending.is_empty() {
+            return Ok(());
+        }
+        let name = file_name(files.len());
+        let path = dir.join(&name);
+        write_table(&path, &Table::from_trials(pending, wheels))?;
+        let bytes = std::fs::read(&path).map_err(|e| DataError::file(&path, e))?;
+        files.push((name, checksum(&bytes)));
+        pending.clear();
+        Ok(())
+    };
+    let totals = generate(
+        cfg,
+        &mut |batch| {
+            pending.extend(batch);
+            if pending.len() >= FILE_TRIALS {
+                flush(&mut pending, &mut files)?;
+            }
+            Ok(())
+        },
+        progress,
+    )?;
+    flush(&mut pending, &mut files)?;
+    let first = &cfg.worlds[0].meta;
+    let (seed, generator) = match &first.source {
+        WorldSource::Generated {
+            set_seed,
+            generator,
+        } => (Some(*set_seed), generator.clone()),
+        WorldSource::VertiBench { .. } => (None, "verti-bench-import".to_string()),
+    };
+    let manifest = Manifest {
+        format: FORMAT.to_string(),
+        kind: cfg.kind,
+        profile: match cfg.source {
+            Source::Random(p) => Some(p),
+            Source::System { .. } => None,
+        },
+        source: cfg.source.name().to_string(),
+        worlds: WorldsInfo {
+            set: info.set.clone(),
+            name: info.set_name.clone(),
+            seed,
+            generator,
+            scale: first.scale,
+            indices: totals.world_indices.clone(),
+        },
+        vehicle: cfg.vehicle.name.clone(),
+        wheels,
+        rate: cfg.rate,
+        max_trial_seconds: cfg.max_trial_seconds,
+        seed: cfg.seed,
+        hours_requested: cfg.hours,
+        hours: totals.seconds / 3600.0,
+        hours_simulated: totals.seconds_simulated / 3600.0,
+        trials: totals.trials,
+        rows: totals.rows,
+        outcomes: totals.outcomes.clone(),
+        eval_worlds: info.eval_worlds,
+        checksums: files.iter().cloned().collect(),
+        files: files.into_iter().map(|f| f.0).collect(),
+        command: info.command.clone(),
+        verti_version: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    manifest.write(dir)?;
+    Ok(manifest)
+}
