@@ -43,6 +43,7 @@ fn settings_text(c: &SwaeConfig) -> String {
 }
 
 /// Exports `net` under `run`'s name with a card, and writes it and its curve.
+#[allow(clippy::too_many_arguments)]
 fn export(
     run: &RunSettings,
     net: &SeqNet,

@@ -17,7 +17,7 @@ pub const PATCH_RESOLUTION: f64 = 0.1;
 pub fn normalise_patch(heights: &[f64], height_scale: f64) -> Vec<f32> {
     let n = (heights.len() as f64).sqrt() as usize;
     // the centre of an even crop lies between four cells: average them
-    let centre = if n % 2 == 0 {
+    let centre = if n.is_multiple_of(2) {
         let (a, b) = (n / 2 - 1, n / 2);
         0.25 * (heights[a * n + a] + heights[a * n + b] + heights[b * n + a] + heights[b * n + b])
     } else {
