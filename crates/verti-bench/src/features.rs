@@ -246,6 +246,22 @@ impl FeatureSource {
     }
 
     /// One feature's value.
+    /// A vehicle standing still at `pose` with idle controls, at time 0 with no time limit
+    /// (observations built outside a trial: tests, dataset patches).
+    pub fn at_rest(pose: Pose6) -> FeatureSource {
+        FeatureSource {
+            time: 0.0,
+            max_time: f64::INFINITY,
+            pose,
+            velocity_body: Vec3::ZERO,
+            angular_velocity_body: Vec3::ZERO,
+            forward_speed: 0.0,
+            steer_angle: 0.0,
+            rolled_over: false,
+            controls: Controls::IDLE,
+        }
+    }
+
     pub fn value(&self, f: Feature) -> f64 {
         let (p, v, w, c) = (
             &self.pose,

@@ -227,17 +227,7 @@ pub fn test_observation<'a>(
         pitch: 0.0,
         yaw,
     };
-    let vehicle = FeatureSource {
-        time: 0.0,
-        max_time: f64::INFINITY,
-        pose,
-        velocity_body: Vec3::ZERO,
-        angular_velocity_body: Vec3::ZERO,
-        forward_speed: 0.0,
-        steer_angle: 0.0,
-        rolled_over: false,
-        controls: Controls::IDLE,
-    };
+    let vehicle = FeatureSource::at_rest(pose);
     Observation::new(world, vehicle, goal, path)
 }
 

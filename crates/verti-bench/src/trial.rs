@@ -150,6 +150,56 @@ pub fn pose6(sim: &Sim, state: &SimState) -> Pose6 {
     }
 }
 
+/// The start state of a trial at `start`: settled on the ground or dropped, as `cfg` says.
+fn initial_state(
+    sim: &Sim,
+    world: &World,
+    cfg: &EpisodeConfig,
+    start: StartPose,
+) -> Result<SimState, String> {
+    match cfg.start {
+        StartMode::Settled => sim.state_at(start),
+        StartMode::Drop => sim.state_dropped(start, StartMode::DROP_HEIGHT * world.meta.scale),
+    }
+    .map_err(|e| format!("cannot start the simulation: {e}"))
+}
+
+impl Trial {
+    /// A trial at its first instant: the clock at zero, idle controls, no outcome yet.
+    #[allow(clippy::too_many_arguments)]
+    fn fresh(
+        world: &Arc<World>,
+        sim: Arc<Sim>,
+        state: SimState,
+        task: Task,
+        info: TaskInfo,
+        cfg: EpisodeConfig,
+        rules: Termination,
+        pose: Pose6,
+        result: TrialResult,
+    ) -> Trial {
+        Trial {
+            world: world.clone(),
+            state,
+            task,
+            info,
+            rules,
+            speed: SpeedController::default(),
+            pose,
+            step_index: 0,
+            next_control: 0.0,
+            controls: Controls::IDLE,
+            result,
+            last_xy: (pose.x, pose.y),
+            ended: None,
+            log: cfg.log_seconds.map(|_| EpisodeLog::default()),
+            started: Instant::now(),
+            cfg,
+            sim,
+        }
+    }
+}
+
 impl Trial {
     /// Starts task `pair` of `world` with the vehicle model `sim` (built for this world with
     /// `Sim::new`; one model serves every task of a world). `system` names who drives, for the results.
@@ -170,33 +220,21 @@ impl Trial {
             .find(|t| t.pair == pair)
             .expect("task_info found it");
         let start = StartPose::new(task.start[0], task.start[1], task.start_yaw());
-        let state = match cfg.start {
-            StartMode::Settled => sim.state_at(start),
-            StartMode::Drop => sim.state_dropped(start, StartMode::DROP_HEIGHT * world.meta.scale),
-        }
-        .map_err(|e| format!("cannot start the simulation: {e}"))?;
+        let state = initial_state(&sim, world, cfg, start)?;
         let pose = pose6(&sim, &state);
         let rules = Termination::new(world, task.goal, cfg, &pose);
         let result = blank_result(world, &spec.name, pair, system, cfg);
-        Ok(Trial {
-            world: world.clone(),
+        Ok(Trial::fresh(
+            world,
+            sim,
             state,
             task,
             info,
-            cfg: cfg.clone(),
+            cfg.clone(),
             rules,
-            speed: SpeedController::default(),
             pose,
-            step_index: 0,
-            next_control: 0.0,
-            controls: Controls::IDLE,
             result,
-            last_xy: (pose.x, pose.y),
-            ended: None,
-            log: cfg.log_seconds.map(|_| EpisodeLog::default()),
-            started: Instant::now(),
-            sim,
-        })
+        ))
     }
 
     /// Starts a goal-less exploration trial at `start` on `world` (datasets: random driving,
@@ -217,11 +255,7 @@ impl Trial {
             success_radius: 0.0,
             ..cfg.clone()
         };
-        let state = match cfg.start {
-            StartMode::Settled => sim.state_at(start),
-            StartMode::Drop => sim.state_dropped(start, StartMode::DROP_HEIGHT * world.meta.scale),
-        }
-        .map_err(|e| format!("cannot start the simulation: {e}"))?;
+        let state = initial_state(&sim, world, &cfg, start)?;
         let spec = sim.spec();
         let here = [start.x, start.y];
         let task = Task {
@@ -245,25 +279,9 @@ impl Trial {
         let rules = Termination::new(world, here, &cfg, &pose);
         let mut result = blank_result(world, &spec.name, 0, system, &cfg);
         result.task = 0;
-        Ok(Trial {
-            world: world.clone(),
-            state,
-            task,
-            info,
-            rules,
-            speed: SpeedController::default(),
-            pose,
-            step_index: 0,
-            next_control: 0.0,
-            controls: Controls::IDLE,
-            result,
-            last_xy: (pose.x, pose.y),
-            ended: None,
-            log: cfg.log_seconds.map(|_| EpisodeLog::default()),
-            started: Instant::now(),
-            cfg,
-            sim,
-        })
+        Ok(Trial::fresh(
+            world, sim, state, task, info, cfg, rules, pose, result,
+        ))
     }
 
     /// Builds the vehicle model for `world` and starts the task (see [`Trial::new`]).

@@ -11,9 +11,7 @@ use crate::{DataError, Result};
 use std::sync::Arc;
 use verti_bench::features::{Feature, FeatureSource};
 use verti_bench::observation::{CropSpec, Observation, Pose6};
-use verti_core::Vec3;
 use verti_core::rng::Rng;
-use verti_sim::Controls;
 use verti_world::World;
 
 /// One mini-batch, row-major: `windows` × `steps` × (features | size × size).
@@ -161,7 +159,8 @@ impl<'a> WindowSampler<'a> {
                     pitch: pose_cols[4][r],
                     yaw: pose_cols[5][r],
                 };
-                let obs = Observation::new(world, at_pose(pose), [pose.x, pose.y], &[]);
+                let obs =
+                    Observation::new(world, FeatureSource::at_rest(pose), [pose.x, pose.y], &[]);
                 b.elevation.extend(
                     obs.elevation_crop(self.crop)
                         .data
@@ -172,20 +171,5 @@ impl<'a> WindowSampler<'a> {
             }
         }
         Ok(b)
-    }
-}
-
-/// A vehicle standing at `pose` (only the pose matters to the crops).
-fn at_pose(pose: Pose6) -> FeatureSource {
-    FeatureSource {
-        time: 0.0,
-        max_time: f64::INFINITY,
-        pose,
-        velocity_body: Vec3::ZERO,
-        angular_velocity_body: Vec3::ZERO,
-        forward_speed: 0.0,
-        steer_angle: 0.0,
-        rolled_over: false,
-        controls: Controls::IDLE,
     }
 }
