@@ -205,10 +205,10 @@ mod with_burn {
         let started = std::time::Instant::now();
         let mut progress = |step: usize, loss: f64| {
             pb.set_position(step as u64);
-            if step % 10 == 0 {
+            if step.is_multiple_of(10) {
                 pb.set_message(format!("loss {loss:.4}"));
             }
-            if quiet && (step % run.eval_every == 0 || step == run.steps) {
+            if quiet && (step.is_multiple_of(run.eval_every) || step == run.steps) {
                 eprintln!(
                     "step {step}/{}: loss {loss:.4} ({:.0} s)",
                     run.steps,
