@@ -81,6 +81,20 @@ impl std::fmt::Display for Shape {
 }
 
 impl LayerSpec {
+    /// The layer's kind as the model card spells it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            LayerSpec::Linear { .. } => "linear",
+            LayerSpec::Conv2d { .. } => "conv2d",
+            LayerSpec::ConvTranspose2d { .. } => "conv_transpose2d",
+            LayerSpec::Relu => "relu",
+            LayerSpec::LeakyRelu { .. } => "leaky_relu",
+            LayerSpec::Tanh => "tanh",
+            LayerSpec::Reshape { .. } => "reshape",
+            LayerSpec::Flatten => "flatten",
+        }
+    }
+
     /// Number of parameters (weights, then biases).
     pub fn parameter_count(&self) -> usize {
         match *self {

@@ -7,11 +7,13 @@
 //! * [`Network`]: feed-forward networks (linear, conv, transposed conv, activations) read from
 //!   a model card ([`ModelCard`], YAML) and a raw f32 weight file, evaluated with fixed-order
 //!   loops that give bit-identical results on every machine;
+//! * [`Mlp`]: the allocation-free MLP path for networks called inside planners;
 //! * [`swae`]: the `swae-v1` elevation source (terrain from the trained SWAE decoder);
 //! * [`patch`]: the local-patch terrain encoder used by learned systems;
 //! * [`shipped`]: the trained models that ship in the repository (`models/`).
 
 pub mod card;
+pub mod dense;
 pub mod layer;
 pub mod network;
 pub mod patch;
@@ -19,6 +21,7 @@ pub mod resize;
 pub mod shipped;
 pub mod swae;
 
+pub use dense::{Mlp, MlpScratch};
 pub use card::{ModelCard, TrainingInfo, WeightsInfo};
 pub use layer::{LayerSpec, Shape};
 pub use network::{ModelError, Network};

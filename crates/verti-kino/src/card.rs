@@ -1,0 +1,206 @@
+//! The kinodynamic model file: one YAML card naming the model's kind, step, normalisation and
+//! training record, plus one verti-nn network file per network it is made of (ensemble
+//! members, heads).
+
+use crate::features::{INPUT_DIM, OUTPUT_DIM, Standardiser};
+use crate::{KinoError, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use verti_nn::{Mlp, Network};
+
+/// Current card format.
+pub const KINO_FORMAT: u32 = 1;
+
+/// How a model turns its networks into a 6-DoF step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KinoKind {
+    /// MPPI-6 (KrModel's spirit): an ensemble of MLPs predicts the full 6-DoF change; members
+    /// are averaged.
+    Ensemble,
+    /// WMVCT: a kinematic bicycle for forward/left/yaw, the terrain height for z, and a
+    /// network for roll and pitch.
+    Decomposed,
+}
+
+impl KinoKind {
+    /// Outputs each network predicts.
+    pub fn network_outputs(self) -> usize {
+        match self {
+            KinoKind::Ensemble => OUTPUT_DIM,
+            KinoKind::Decomposed => 2,
+        }
+    }
+}
+
+/// What training did (mirrors verti-nn's card so a reader finds the same fields).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KinoTraining {
+    pub data: String,
+    pub worlds: String,
+    pub command: String,
+    pub seed: u64,
+    pub steps: usize,
+    pub wall_time_s: f64,
+    pub verti_version: String,
+    pub settings: String,
+}
+
+/// The model card of a kinodynamic model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KinoCard {
+    pub name: String,
+    pub format: u32,
+    pub summary: String,
+    pub kind: KinoKind,
+    /// Vehicle the training data were driven with, and the model step (full-scale seconds).
+    pub vehicle: String,
+    pub dt: f64,
+    pub inputs: Vec<String>,
+    pub input_mean: Vec<f64>,
+    pub input_std: Vec<f64>,
+    /// Standardisation of what the networks predict (`kind.network_outputs()` values).
+    pub output_mean: Vec<f64>,
+    pub output_std: Vec<f64>,
+    /// Network card files, relative to this card.
+    pub networks: Vec<String>,
+    pub training: KinoTraining,
+    pub metrics: BTreeMap<String, f64>,
+}
+
+/// A loaded model: card and networks, checked against each other.
+#[derive(Clone, Debug)]
+pub struct KinoFile {
+    pub card: KinoCard,
+    pub input: Standardiser,
+    pub output: Standardiser,
+    pub networks: Vec<Arc<Network>>,
+    pub mlps: Vec<Mlp>,
+}
+
+impl KinoFile {
+    /// Checks a card and its networks: dimensions, step, formats.
+    pub fn new(card: KinoCard, networks: Vec<Arc<Network>>, origin: &Path) -> Result<KinoFile> {
+        let bad = |field: &str, why: String| KinoError::Card {
+            path: origin.to_path_buf(),
+            field: field.to_string(),
+            why,
+        };
+        if card.format != KINO_FORMAT {
+            return Err(bad(
+                "format",
+                format!("{} is not supported (this verti reads {KINO_FORMAT})", card.format),
+            ));
+        }
+        if !(card.dt.is_finite() && card.dt > 0.0) {
+            return Err(bad("dt", format!("{} must be a positive time", card.dt)));
+        }
+        let outputs = card.kind.network_outputs();
+        for (field, v, n) in [
+            ("input_mean", &card.input_mean, INPUT_DIM),
+            ("input_std", &card.input_std, INPUT_DIM),
+            ("output_mean", &card.output_mean, outputs),
+            ("output_std", &card.output_std, outputs),
+        ] {
+            if v.len() != n {
+                return Err(bad(field, format!("{} values, expected {n}", v.len())));
+            }
+            if v.iter().any(|x| !x.is_finite()) || (field.ends_with("std") && v.contains(&0.0)) {
+                return Err(bad(field, "values must be finite (and non-zero for std)".into()));
+            }
+        }
+        if networks.is_empty() || networks.len() != card.networks.len() {
+            return Err(bad(
+                "networks",
+                format!("{} listed, {} loaded", card.networks.len(), networks.len()),
+            ));
+        }
+        let mut mlps = Vec::new();
+        for (file, net) in card.networks.iter().zip(&networks) {
+            let mlp = Mlp::from_network(net).map_err(|e| bad("networks", format!("{file}: {e}")))?;
+            if mlp.inputs() != INPUT_DIM || mlp.outputs() != outputs {
+                return Err(bad(
+                    "networks",
+                    format!(
+                        "{file} maps {} inputs to {}, a {:?} model needs {INPUT_DIM} to {outputs}",
+                        mlp.inputs(),
+                        mlp.outputs(),
+                        card.kind
+                    ),
+                ));
+            }
+            mlps.push(mlp);
+        }
+        Ok(KinoFile {
+            input: Standardiser {
+                mean: card.input_mean.clone(),
+                std: card.input_std.clone(),
+            },
+            output: Standardiser {
+                mean: card.output_mean.clone(),
+                std: card.output_std.clone(),
+            },
+            card,
+            networks,
+            mlps,
+        })
+    }
+
+    /// Reads a card and the networks it lists (beside it).
+    pub fn load(path: &Path) -> Result<KinoFile> {
+        let text = std::fs::read_to_string(path).map_err(|e| KinoError::Io {
+            path: path.to_path_buf(),
+            source: e,
+        })?;
+        let card = parse_card(&text, path)?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let networks = card
+            .networks
+            .iter()
+            .map(|f| {
+                Network::load(&dir.join(f)).map(Arc::new).map_err(|e| KinoError::Card {
+                    path: path.to_path_buf(),
+                    field: "networks".into(),
+                    why: e.to_string(),
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        KinoFile::new(card, networks, path)
+    }
+
+    /// Writes the card to `path` and each network beside it under its listed name.
+    pub fn save(&self, path: &Path) -> Result<()> {
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let io = |p: PathBuf, e: std::io::Error| KinoError::Io { path: p, source: e };
+        std::fs::create_dir_all(dir).map_err(|e| io(dir.to_path_buf(), e))?;
+        for (file, net) in self.card.networks.iter().zip(&self.networks) {
+            net.save(&dir.join(file)).map_err(|e| KinoError::Card {
+                path: dir.join(file),
+                field: "networks".into(),
+                why: e.to_string(),
+            })?;
+        }
+        let text = serde_norway::to_string(&self.card).map_err(|e| KinoError::Card {
+            path: path.to_path_buf(),
+            field: "card".into(),
+            why: e.to_string(),
+        })?;
+        std::fs::write(path, text).map_err(|e| io(path.to_path_buf(), e))
+    }
+}
+
+/// Parses a card's YAML, naming the file in errors.
+pub fn parse_card(text: &str, path: &Path) -> Result<KinoCard> {
+    serde_norway::from_str(text).map_err(|e| KinoError::Card {
+        path: path.to_path_buf(),
+        field: e
+            .location()
+            .map(|l| format!("line {}", l.line()))
+            .unwrap_or_else(|| "card".into()),
+        why: e.to_string(),
+    })
+}

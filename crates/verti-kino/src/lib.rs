@@ -1,0 +1,40 @@
+//! Learned 6-DoF kinodynamic models for verti's sampling planners (paper §IV-A: WMVCT,
+//! MPPI-6, TAL, TNT), without a learning framework: training lives in `verti-learn`; what
+//! planning and evaluation need is here, in plain Rust.
+//!
+//! * [`features`]: what a model sees and predicts, one code path for training and planning;
+//! * [`card`]: the model file (a YAML card plus verti-nn networks);
+//! * [`model`]: one model step in world units, and the kinematic bicycle baseline;
+//! * [`rollout`]: a model inside MPPI ([`rollout::LearnedRollout`]) and the attitude-aware cost;
+//! * [`systems`]: the registered planners (`mppi6`, `wmvct`, ...).
+
+use std::path::PathBuf;
+
+pub mod card;
+pub mod features;
+pub mod model;
+pub mod rollout;
+pub mod systems;
+
+pub use card::{KinoCard, KinoFile, KinoKind};
+pub use features::{KinoState, Units};
+pub use model::{Geometry, KinoModel};
+
+#[derive(Debug, thiserror::Error)]
+pub enum KinoError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: {field}: {why}")]
+    Card {
+        path: PathBuf,
+        field: String,
+        why: String,
+    },
+    #[error("{0}")]
+    Data(String),
+}
+
+pub type Result<T> = std::result::Result<T, KinoError>;

@@ -1,0 +1,197 @@
+//! One step of a learned kinodynamic model, in world units: used alike by MPPI's rollouts, by
+//! the accuracy evaluation and (through [`crate::features`]) by training.
+
+use crate::card::{KinoFile, KinoKind};
+use crate::features::{
+    INPUT_DIM, KinoState, OUTPUT_DIM, Units, apply_delta, heading_delta, write_inputs,
+};
+use std::sync::Arc;
+use verti_bench::observation::Pose6;
+use verti_core::math::wrap_angle;
+use verti_nn::MlpScratch;
+use verti_world::Heightfield;
+
+/// Geometry the decomposed model's bicycle needs (from the task).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Geometry {
+    pub wheelbase: f64,
+    pub max_steer: f64,
+}
+
+impl Default for Geometry {
+    fn default() -> Self {
+        // the HMMWV's
+        Geometry {
+            wheelbase: 3.378,
+            max_steer: 0.5,
+        }
+    }
+}
+
+/// Work buffers of one caller (one per thread).
+#[derive(Clone, Debug)]
+pub struct StepScratch {
+    input: [f32; INPUT_DIM],
+    out: Vec<f32>,
+    sum: Vec<f32>,
+    mlp: MlpScratch,
+}
+
+/// A loaded model, cheap to clone (the file is shared).
+#[derive(Clone, Debug)]
+pub struct KinoModel {
+    file: Arc<KinoFile>,
+}
+
+impl KinoModel {
+    pub fn new(file: Arc<KinoFile>) -> KinoModel {
+        KinoModel { file }
+    }
+    pub fn file(&self) -> &KinoFile {
+        &self.file
+    }
+    pub fn name(&self) -> &str {
+        &self.file.card.name
+    }
+    /// The model step in full-scale seconds.
+    pub fn dt(&self) -> f64 {
+        self.file.card.dt
+    }
+    /// Multiply-adds of the networks per step.
+    pub fn multiply_adds(&self) -> usize {
+        self.file.mlps.iter().map(|m| m.multiply_adds()).sum()
+    }
+
+    pub fn scratch(&self) -> StepScratch {
+        let n = self.file.card.kind.network_outputs();
+        StepScratch {
+            input: [0.0; INPUT_DIM],
+            out: vec![0.0; n],
+            sum: vec![0.0; n],
+            mlp: self.file.mlps[0].scratch(),
+        }
+    }
+
+    /// The networks' mean prediction (standardised outputs averaged, then un-standardised)
+    /// for the inputs already in `scratch.input`, into `out`.
+    fn predict(&self, scratch: &mut StepScratch, out: &mut [f64]) {
+        let f = &*self.file;
+        f.input.apply(&mut scratch.input);
+        scratch.sum.iter_mut().for_each(|v| *v = 0.0);
+        for mlp in &f.mlps {
+            mlp.forward_into(&scratch.input, &mut scratch.mlp, &mut scratch.out);
+            for (s, o) in scratch.sum.iter_mut().zip(&scratch.out) {
+                *s += o;
+            }
+        }
+        let inv = 1.0 / f.mlps.len() as f32;
+        scratch.sum.iter_mut().for_each(|v| *v *= inv);
+        f.output.invert(&scratch.sum, out);
+    }
+
+    /// The state one model step later under `command` (target speed m/s, steering), world
+    /// units. `terrain` is the world's (undeformed) ground.
+    pub fn step(
+        &self,
+        state: &KinoState,
+        command: (f64, f64),
+        terrain: &Heightfield,
+        units: Units,
+        geometry: Geometry,
+        scratch: &mut StepScratch,
+    ) -> KinoState {
+        let dt = self.dt();
+        write_inputs(state, command, terrain, units, dt, &mut scratch.input);
+        let pose = &state.pose;
+        let delta = match self.file.card.kind {
+            KinoKind::Ensemble => {
+                let mut d = [0.0; OUTPUT_DIM];
+                self.predict(scratch, &mut d);
+                units.delta_to_world(&d)
+            }
+            KinoKind::Decomposed => {
+                let mut rp = [0.0; 2];
+                self.predict(scratch, &mut rp);
+                let dt_world = dt / units.time_factor();
+                let mut d = bicycle_delta(command, geometry, dt_world);
+                // z follows the ground: the ride height over the terrain is held
+                let ride = pose.z - terrain.height_at(pose.x, pose.y);
+                let next = apply_delta(pose, &d);
+                d[2] = terrain.height_at(next.x, next.y) + ride - pose.z;
+                d[4] = rp[0];
+                d[5] = rp[1];
+                d
+            }
+        };
+        KinoState {
+            pose: apply_delta(pose, &delta),
+            last_delta: delta,
+        }
+    }
+}
+
+/// Heading-frame change of a kinematic bicycle driving `command` for `dt` seconds: it turns
+/// by dψ = v/L·tan(δ)·dt along a circular arc (chord at half the turn).
+pub fn bicycle_delta(command: (f64, f64), g: Geometry, dt: f64) -> [f64; OUTPUT_DIM] {
+    let (v, steer) = command;
+    let dpsi = v / g.wheelbase * (steer.clamp(-1.0, 1.0) * g.max_steer).tan() * dt;
+    let chord = if dpsi.abs() < 1e-9 {
+        v * dt
+    } else {
+        v * dt * (0.5 * dpsi).sin() / (0.5 * dpsi)
+    };
+    let (s, c) = (0.5 * dpsi).sin_cos();
+    [chord * c, chord * s, 0.0, wrap_angle(dpsi), 0.0, 0.0]
+}
+
+/// The bicycle as a model of the same shape as the learned ones: forward/left/yaw from the
+/// command, z held on the ground (ride height kept), roll and pitch held. The baseline every
+/// learned model is compared with.
+pub fn bicycle_step(
+    state: &KinoState,
+    command: (f64, f64),
+    terrain: &Heightfield,
+    geometry: Geometry,
+    dt_world: f64,
+) -> KinoState {
+    let pose = &state.pose;
+    let mut d = bicycle_delta(command, geometry, dt_world);
+    let ride = pose.z - terrain.height_at(pose.x, pose.y);
+    let next = apply_delta(pose, &d);
+    d[2] = terrain.height_at(next.x, next.y) + ride - pose.z;
+    KinoState {
+        pose: apply_delta(pose, &d),
+        last_delta: d,
+    }
+}
+
+/// The state at `pose` given the pose one model step earlier.
+pub fn state_from(previous: &Pose6, pose: &Pose6) -> KinoState {
+    KinoState {
+        pose: *pose,
+        last_delta: heading_delta(previous, pose),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bicycle_arc_matches_the_circle() {
+        let g = Geometry {
+            wheelbase: 2.0,
+            max_steer: 0.5,
+        };
+        let (v, dt) = (3.0, 0.5);
+        let d = bicycle_delta((v, 1.0), g, dt);
+        let radius = g.wheelbase / 0.5f64.tan();
+        let dpsi = v * dt / radius;
+        // exact point on the circle after arc length v·dt
+        let (x, y) = (radius * dpsi.sin(), radius * (1.0 - dpsi.cos()));
+        assert!((d[0] - x).abs() < 1e-12 && (d[1] - y).abs() < 1e-12);
+        assert!((d[3] - dpsi).abs() < 1e-12);
+        let straight = bicycle_delta((v, 0.0), g, dt);
+        assert_eq!(straight, [1.5, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    }
+}

@@ -1,0 +1,133 @@
+//! The learned planners as mobility systems: MPPI ([`verti_systems::mppi::Mppi`]) with a
+//! learned model ([`LearnedRollout`]) and the attitude-aware cost ([`AttitudeCost`]).
+
+use crate::card::KinoFile;
+use crate::model::KinoModel;
+use crate::rollout::{AttitudeCost, AttitudeWeights, LearnedRollout};
+use std::path::Path;
+use std::sync::{Arc, OnceLock};
+use verti_bench::{MobilitySystem, SystemInfo, SystemRegistry};
+use verti_core::Factory;
+use verti_core::params::{ParamError, ParamSpec, ParamValue, Params};
+use verti_systems::mppi::Mppi;
+use verti_systems::registry::{mppi_from, mppi_params};
+use verti_systems::rollout::PathCostWeights;
+
+/// Where a system's default model comes from (the shipped weights, loaded once).
+pub type ModelSource = fn() -> Result<Arc<KinoFile>, String>;
+
+/// A learned planner: a name, a summary and its default model.
+pub struct LearnedSystem {
+    pub name: &'static str,
+    pub summary: &'static str,
+    pub default_model: ModelSource,
+    loaded: OnceLock<Result<Arc<KinoFile>, String>>,
+}
+
+impl LearnedSystem {
+    pub fn new(name: &'static str, summary: &'static str, default_model: ModelSource) -> Self {
+        LearnedSystem {
+            name,
+            summary,
+            default_model,
+            loaded: OnceLock::new(),
+        }
+    }
+}
+
+/// MPPI defaults for learned models: the reference's 800 samples x 20 steps; one step is one
+/// model step (0.2 s for the shipped models), so the horizon spans 4 s.
+fn params() -> Vec<ParamSpec> {
+    let w = AttitudeWeights::default();
+    let mut specs: Vec<ParamSpec> = mppi_params()
+        .into_iter()
+        .filter(|s| s.name != "step")
+        .map(|mut s| {
+            if s.name == "horizon" {
+                s.default = ParamValue::Int(20);
+            }
+            s
+        })
+        .collect();
+    let rate = specs.pop().expect("rate is last");
+    specs.extend([
+        ParamSpec::float("w_goal", w.path.goal, 0.0, 1e6, "weight of the distance to the local goal"),
+        ParamSpec::float(
+            "w_obstacle",
+            w.path.obstacle,
+            0.0,
+            1e6,
+            "cost per rollout step inside an obstacle or off the map",
+        ),
+        ParamSpec::float("w_control", w.path.control, 0.0, 1e6, "weight of the control cost"),
+        ParamSpec::float(
+            "w_attitude",
+            w.attitude,
+            0.0,
+            1e6,
+            "weight of predicted roll and pitch beyond 10 degrees (squared, radians)",
+        ),
+        ParamSpec::float(
+            "w_tip",
+            w.tip,
+            0.0,
+            1e6,
+            "cost per step with predicted roll or pitch beyond 30 degrees",
+        ),
+        ParamSpec::path("model", "", "model card (YAML) to use instead of the shipped one"),
+        rate,
+    ]);
+    specs
+}
+
+impl Factory<dyn MobilitySystem> for LearnedSystem {
+    fn info(&self) -> SystemInfo {
+        SystemInfo {
+            name: self.name.into(),
+            summary: self.summary.into(),
+            params: params(),
+        }
+    }
+
+    fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
+        let file = match p.path("model") {
+            Some(path) if path != Path::new("") => {
+                Arc::new(KinoFile::load(path).map_err(|e| e.to_string())?)
+            }
+            _ => self
+                .loaded
+                .get_or_init(|| (self.default_model)())
+                .clone()?,
+        };
+        let mut mppi = mppi_from(p);
+        mppi.step = file.card.dt;
+        let weights = AttitudeWeights {
+            path: PathCostWeights {
+                goal: p.float("w_goal"),
+                obstacle: p.float("w_obstacle"),
+                control: p.float("w_control"),
+            },
+            attitude: p.float("w_attitude"),
+            tip: p.float("w_tip"),
+            ..AttitudeWeights::default()
+        };
+        let model = LearnedRollout::new(KinoModel::new(file));
+        Ok(Box::new(Mppi::with_model(
+            self.name,
+            mppi,
+            Box::new(model),
+            Box::new(AttitudeCost::new(weights)),
+        )))
+    }
+}
+
+/// Registers the learned planners whose models ship with verti.
+pub fn register(
+    registry: &mut SystemRegistry,
+    systems: Vec<LearnedSystem>,
+) -> Result<(), ParamError> {
+    for s in systems {
+        registry.register(s)?;
+    }
+    Ok(())
+}
