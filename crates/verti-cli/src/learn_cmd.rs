@@ -12,6 +12,50 @@ pub enum LearnCommand {
     Swae(SwaeArgs),
     /// Train the local-patch terrain encoder (`patch-v1`) on crops from training worlds.
     Patch(PatchArgs),
+    /// Train a learned kinodynamic model (`mppi6`, `wmvct`) on random-exploration data.
+    Kino(KinoArgs),
+}
+
+#[derive(Args)]
+pub struct KinoArgs {
+    /// Which model: mppi6 (an ensemble predicting the full 6-DoF change) or wmvct (bicycle
+    /// for x/y/yaw, terrain for z, a network for roll and pitch).
+    #[arg(long, value_parser = ["mppi6", "wmvct"])]
+    pub model: String,
+    /// Training dataset (`verti data generate random --worlds verti-100-s1 ...`).
+    #[arg(long, default_value = "data/random-s1")]
+    pub data: PathBuf,
+    /// Validation dataset, driven on other worlds (e.g. verti-100-s2).
+    #[arg(long, default_value = "data/random-s2")]
+    pub val: PathBuf,
+    /// Model card to write (default models/MODEL-v1.yaml; networks and curve beside it).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Model step, full-scale seconds (a multiple of the data's row period).
+    #[arg(long, default_value_t = 0.2)]
+    pub dt: f64,
+    /// Ensemble members (default: 3 for mppi6, 1 for wmvct).
+    #[arg(long)]
+    pub members: Option<usize>,
+    /// Hidden layer widths, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "32,32")]
+    pub hidden: Vec<usize>,
+    /// Optimiser steps per member.
+    #[arg(long, default_value_t = 4000)]
+    pub steps: usize,
+    #[arg(long, default_value_t = 256)]
+    pub batch: usize,
+    #[arg(long, default_value_t = 3e-3)]
+    pub lr: f64,
+    #[arg(long, default_value_t = 1e-5)]
+    pub lr_final: f64,
+    /// Open-loop horizon of the multi-step validation metric, model steps.
+    #[arg(long, default_value_t = 10)]
+    pub horizon: usize,
+    #[arg(long, default_value_t = 250)]
+    pub eval_every: usize,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
 }
 
 /// Settings shared by the autoencoders (defaults depend on the model).
@@ -151,6 +195,9 @@ mod with_burn {
 
     pub fn run(cmd: LearnCommand) -> Result<(), String> {
         let device = verti_learn::training_device();
+        if let LearnCommand::Kino(a) = &cmd {
+            return crate::learn_kino::run(a, &command_line(), &device);
+        }
         let (run, data) = match &cmd {
             LearnCommand::Swae(a) => (
                 config(
@@ -172,6 +219,7 @@ mod with_burn {
                 ),
                 &a.out,
             ),
+            LearnCommand::Kino(_) => unreachable!("handled above"),
             LearnCommand::Patch(a) => (
                 config(
                     &a.train,
@@ -232,6 +280,7 @@ mod with_burn {
                 &device,
                 &mut progress,
             )?,
+            LearnCommand::Kino(_) => unreachable!("handled above"),
         };
         pb.finish_and_clear();
         report(&trained);

@@ -3,7 +3,10 @@
 mod compare_cmd;
 mod data_cmd;
 mod eval_cmd;
+mod kino_cmd;
 mod learn_cmd;
+#[cfg(feature = "learn")]
+mod learn_kino;
 mod outputs;
 mod progress;
 mod registries;
@@ -46,6 +49,9 @@ enum Command {
     /// Train the shipped models (needs the `learn` feature: `--features learn`).
     #[command(subcommand)]
     Learn(learn_cmd::LearnCommand),
+    /// Learned kinodynamic models: accuracy against the bicycle model.
+    #[command(subcommand)]
+    Kino(kino_cmd::KinoCommand),
     /// Datasets: random exploration, failure cases and expert demonstrations (Parquet).
     #[command(subcommand)]
     Data(data_cmd::DataCommand),
@@ -87,6 +93,7 @@ fn main() -> ExitCode {
         Command::Report(a) => eval_cmd::report(a),
         Command::Learn(cmd) => learn_cmd::run(cmd).map_err(Into::into),
         Command::Data(cmd) => data_cmd::run(cmd),
+        Command::Kino(cmd) => kino_cmd::run(cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

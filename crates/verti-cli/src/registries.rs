@@ -9,6 +9,9 @@ use verti_world::generate::sources::ElevationRegistry;
 pub fn systems() -> SystemRegistry {
     let mut r = SystemRegistry::new();
     verti_systems::register(&mut r);
+    // the learned planners (MPPI over shipped kinodynamic models), evaluated without burn
+    verti_kino::systems::register(&mut r, verti_kino::shipped::systems())
+        .expect("learned system names are unique");
     r
 }
 

@@ -21,7 +21,7 @@ pub enum KinoKind {
     /// are averaged.
     Ensemble,
     /// WMVCT: a kinematic bicycle for forward/left/yaw, the terrain height for z, and a
-    /// network for roll and pitch.
+    /// network for the next roll and pitch (absolute, not a change).
     Decomposed,
 }
 
@@ -79,6 +79,8 @@ pub struct KinoFile {
     pub input: Standardiser,
     pub output: Standardiser,
     pub networks: Vec<Arc<Network>>,
+    /// The networks as MLPs on raw inputs and raw outputs (the standardisation folded into
+    /// their first and last layers).
     pub mlps: Vec<Mlp>,
 }
 
@@ -93,7 +95,10 @@ impl KinoFile {
         if card.format != KINO_FORMAT {
             return Err(bad(
                 "format",
-                format!("{} is not supported (this verti reads {KINO_FORMAT})", card.format),
+                format!(
+                    "{} is not supported (this verti reads {KINO_FORMAT})",
+                    card.format
+                ),
             ));
         }
         if !(card.dt.is_finite() && card.dt > 0.0) {
@@ -110,7 +115,10 @@ impl KinoFile {
                 return Err(bad(field, format!("{} values, expected {n}", v.len())));
             }
             if v.iter().any(|x| !x.is_finite()) || (field.ends_with("std") && v.contains(&0.0)) {
-                return Err(bad(field, "values must be finite (and non-zero for std)".into()));
+                return Err(bad(
+                    field,
+                    "values must be finite (and non-zero for std)".into(),
+                ));
             }
         }
         if networks.is_empty() || networks.len() != card.networks.len() {
@@ -121,7 +129,8 @@ impl KinoFile {
         }
         let mut mlps = Vec::new();
         for (file, net) in card.networks.iter().zip(&networks) {
-            let mlp = Mlp::from_network(net).map_err(|e| bad("networks", format!("{file}: {e}")))?;
+            let mlp =
+                Mlp::from_network(net).map_err(|e| bad("networks", format!("{file}: {e}")))?;
             if mlp.inputs() != INPUT_DIM || mlp.outputs() != outputs {
                 return Err(bad(
                     "networks",
@@ -133,7 +142,15 @@ impl KinoFile {
                     ),
                 ));
             }
-            mlps.push(mlp);
+            let folded = mlp
+                .fold_standardisation(
+                    &card.input_mean,
+                    &card.input_std,
+                    &card.output_mean,
+                    &card.output_std,
+                )
+                .map_err(|e| bad("networks", format!("{file}: {e}")))?;
+            mlps.push(folded);
         }
         Ok(KinoFile {
             input: Standardiser {
@@ -162,11 +179,13 @@ impl KinoFile {
             .networks
             .iter()
             .map(|f| {
-                Network::load(&dir.join(f)).map(Arc::new).map_err(|e| KinoError::Card {
-                    path: path.to_path_buf(),
-                    field: "networks".into(),
-                    why: e.to_string(),
-                })
+                Network::load(&dir.join(f))
+                    .map(Arc::new)
+                    .map_err(|e| KinoError::Card {
+                        path: path.to_path_buf(),
+                        field: "networks".into(),
+                        why: e.to_string(),
+                    })
             })
             .collect::<Result<Vec<_>>>()?;
         KinoFile::new(card, networks, path)

@@ -34,7 +34,15 @@ pub const OUTPUT_NAMES: [&str; OUTPUT_DIM] = ["fwd", "left", "z", "yaw", "roll",
 /// The input features' names, in order (for cards and error messages).
 pub fn input_names() -> Vec<String> {
     let mut names: Vec<String> = [
-        "roll", "pitch", "v_fwd", "v_left", "v_z", "w_yaw", "w_roll", "w_pitch", "cmd_speed",
+        "roll",
+        "pitch",
+        "v_fwd",
+        "v_left",
+        "v_z",
+        "w_yaw",
+        "w_roll",
+        "w_pitch",
+        "cmd_speed",
         "cmd_steer",
     ]
     .iter()

@@ -11,9 +11,12 @@
 use std::path::PathBuf;
 
 pub mod card;
+pub mod eval;
 pub mod features;
 pub mod model;
 pub mod rollout;
+pub mod samples;
+pub mod shipped;
 pub mod systems;
 
 pub use card::{KinoCard, KinoFile, KinoKind};

@@ -72,11 +72,10 @@ impl KinoModel {
         }
     }
 
-    /// The networks' mean prediction (standardised outputs averaged, then un-standardised)
-    /// for the inputs already in `scratch.input`, into `out`.
+    /// The networks' mean prediction for the raw inputs in `scratch.input`, into `out` (the
+    /// standardisation is folded into the networks).
     fn predict(&self, scratch: &mut StepScratch, out: &mut [f64]) {
         let f = &*self.file;
-        f.input.apply(&mut scratch.input);
         scratch.sum.iter_mut().for_each(|v| *v = 0.0);
         for mlp in &f.mlps {
             mlp.forward_into(&scratch.input, &mut scratch.mlp, &mut scratch.out);
@@ -84,9 +83,10 @@ impl KinoModel {
                 *s += o;
             }
         }
-        let inv = 1.0 / f.mlps.len() as f32;
-        scratch.sum.iter_mut().for_each(|v| *v *= inv);
-        f.output.invert(&scratch.sum, out);
+        let inv = 1.0 / f.mlps.len() as f64;
+        for (o, s) in out.iter_mut().zip(&scratch.sum) {
+            *o = *s as f64 * inv;
+        }
     }
 
     /// The state one model step later under `command` (target speed m/s, steering), world
@@ -118,8 +118,9 @@ impl KinoModel {
                 let ride = pose.z - terrain.height_at(pose.x, pose.y);
                 let next = apply_delta(pose, &d);
                 d[2] = terrain.height_at(next.x, next.y) + ride - pose.z;
-                d[4] = rp[0];
-                d[5] = rp[1];
+                // the network predicts the next attitude itself
+                d[4] = rp[0] - pose.roll;
+                d[5] = rp[1] - pose.pitch;
                 d
             }
         };

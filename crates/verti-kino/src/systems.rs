@@ -51,7 +51,13 @@ fn params() -> Vec<ParamSpec> {
         .collect();
     let rate = specs.pop().expect("rate is last");
     specs.extend([
-        ParamSpec::float("w_goal", w.path.goal, 0.0, 1e6, "weight of the distance to the local goal"),
+        ParamSpec::float(
+            "w_goal",
+            w.path.goal,
+            0.0,
+            1e6,
+            "weight of the distance to the local goal",
+        ),
         ParamSpec::float(
             "w_obstacle",
             w.path.obstacle,
@@ -59,7 +65,13 @@ fn params() -> Vec<ParamSpec> {
             1e6,
             "cost per rollout step inside an obstacle or off the map",
         ),
-        ParamSpec::float("w_control", w.path.control, 0.0, 1e6, "weight of the control cost"),
+        ParamSpec::float(
+            "w_control",
+            w.path.control,
+            0.0,
+            1e6,
+            "weight of the control cost",
+        ),
         ParamSpec::float(
             "w_attitude",
             w.attitude,
@@ -74,7 +86,11 @@ fn params() -> Vec<ParamSpec> {
             1e6,
             "cost per step with predicted roll or pitch beyond 30 degrees",
         ),
-        ParamSpec::path("model", "", "model card (YAML) to use instead of the shipped one"),
+        ParamSpec::path(
+            "model",
+            "",
+            "model card (YAML) to use instead of the shipped one",
+        ),
         rate,
     ]);
     specs
@@ -94,13 +110,18 @@ impl Factory<dyn MobilitySystem> for LearnedSystem {
             Some(path) if path != Path::new("") => {
                 Arc::new(KinoFile::load(path).map_err(|e| e.to_string())?)
             }
-            _ => self
-                .loaded
-                .get_or_init(|| (self.default_model)())
-                .clone()?,
+            _ => self.loaded.get_or_init(|| (self.default_model)()).clone()?,
         };
-        let mut mppi = mppi_from(p);
-        mppi.step = file.card.dt;
+        // `step` is not a parameter here: one rollout step is one model step
+        let specs = mppi_params();
+        let mut pairs: Vec<(String, ParamValue)> = p
+            .to_pairs()
+            .into_iter()
+            .filter(|(n, _)| specs.iter().any(|s| &s.name == n))
+            .collect();
+        pairs.push(("step".into(), ParamValue::Float(file.card.dt)));
+        let mppi =
+            mppi_from(&Params::resolve(self.name, specs, &pairs).map_err(|e| e.to_string())?);
         let weights = AttitudeWeights {
             path: PathCostWeights {
                 goal: p.float("w_goal"),

@@ -5,8 +5,13 @@
 //! benchmark evaluates without burn. Choose the device with burn's `BURN_DEVICE` environment
 //! variable where a GPU backend is compiled in (feature `cuda`).
 
+/// The device type training functions take.
+pub use burn::tensor::Device;
+
 pub mod commands;
 pub mod elev_maps;
+pub mod kino;
+pub mod kino_command;
 pub mod patches;
 pub mod seq;
 pub mod swae;

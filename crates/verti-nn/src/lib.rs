@@ -21,8 +21,8 @@ pub mod resize;
 pub mod shipped;
 pub mod swae;
 
-pub use dense::{Mlp, MlpScratch};
 pub use card::{ModelCard, TrainingInfo, WeightsInfo};
+pub use dense::{Mlp, MlpScratch};
 pub use layer::{LayerSpec, Shape};
 pub use network::{ModelError, Network};
 pub use patch::PatchEncoder;

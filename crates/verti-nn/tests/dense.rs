@@ -2,7 +2,7 @@
 
 use std::collections::BTreeMap;
 use verti_core::Rng;
-use verti_nn::{LayerSpec, ModelCard, Mlp, Network, Shape, TrainingInfo, WeightsInfo};
+use verti_nn::{LayerSpec, Mlp, ModelCard, Network, Shape, TrainingInfo, WeightsInfo};
 
 fn card(layers: Vec<LayerSpec>, inputs: usize) -> ModelCard {
     ModelCard {
@@ -60,7 +60,10 @@ fn mlp_matches_the_network_bit_for_bit() {
         let x: Vec<f32> = (0..13).map(|_| rng.normal() as f32 * 2.0).collect();
         mlp.forward_into(&x, &mut scratch, &mut out);
         let want = net.forward(&x);
-        let same = out.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits());
+        let same = out
+            .iter()
+            .zip(&want)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
         assert!(same, "{out:?} vs {want:?}");
     }
 }
@@ -90,4 +93,42 @@ fn networks_that_are_not_mlps_are_refused_by_name() {
     ];
     let err = Mlp::from_network(&random_network(double, 2, &mut rng)).unwrap_err();
     assert!(err.contains("layer 2"), "{err}");
+}
+
+#[test]
+fn folded_standardisation_equals_standardising_around_the_network() {
+    let mut rng = Rng::new(3);
+    let lin = |inputs, outputs| LayerSpec::Linear { inputs, outputs };
+    let net = random_network(vec![lin(5, 12), LayerSpec::Relu, lin(12, 3)], 5, &mut rng);
+    let mlp = Mlp::from_network(&net).unwrap();
+    let (im, is) = (
+        vec![1.0, -2.0, 0.5, 3.0, 0.0],
+        vec![2.0, 0.5, 1.0, 4.0, 0.1],
+    );
+    let (om, os) = (vec![0.3, -1.0, 10.0], vec![0.01, 2.0, 5.0]);
+    let folded = mlp.fold_standardisation(&im, &is, &om, &os).unwrap();
+    for _ in 0..20 {
+        let x: Vec<f32> = (0..5).map(|_| rng.normal() as f32 * 3.0).collect();
+        let z: Vec<f32> = x
+            .iter()
+            .zip(im.iter().zip(&is))
+            .map(|(v, (m, s))| ((*v as f64 - m) / s) as f32)
+            .collect();
+        let want: Vec<f64> = mlp
+            .forward(&z)
+            .iter()
+            .zip(om.iter().zip(&os))
+            .map(|(v, (m, s))| *v as f64 * s + m)
+            .collect();
+        let got = folded.forward(&x);
+        for (g, w) in got.iter().zip(&want) {
+            assert!(
+                (*g as f64 - w).abs() <= 1e-4 * (1.0 + w.abs()),
+                "{got:?} vs {want:?}"
+            );
+        }
+    }
+    let tanh_last = random_network(vec![lin(5, 3), LayerSpec::Tanh], 5, &mut rng);
+    let m = Mlp::from_network(&tanh_last).unwrap();
+    assert!(m.fold_standardisation(&im, &is, &om, &os).is_err());
 }

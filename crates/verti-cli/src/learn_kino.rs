@@ -1,0 +1,102 @@
+//! `verti learn kino` (with the `learn` feature): trains a learned kinodynamic model.
+
+use crate::learn_cmd::KinoArgs;
+use crate::progress::bar;
+use std::path::PathBuf;
+use verti_kino::KinoKind;
+use verti_kino::features::OUTPUT_NAMES;
+use verti_learn::Device;
+use verti_learn::kino::KinoConfig;
+use verti_learn::kino_command::{KinoRun, learn_kino};
+
+pub fn run(a: &KinoArgs, command: &str, device: &Device) -> Result<(), String> {
+    let (kind, members, summary) = match a.model.as_str() {
+        "mppi6" => (
+            KinoKind::Ensemble,
+            3,
+            "MPPI-6's model: an ensemble of MLPs predicting the full 6-DoF pose change over one \
+             step from attitude, pose rates, command and the terrain under and ahead",
+        ),
+        _ => (
+            KinoKind::Decomposed,
+            1,
+            "WMVCT's model: a kinematic bicycle for forward, left and yaw, the terrain height \
+             for z, and an MLP for the next roll and pitch",
+        ),
+    };
+    let name = format!("{}-v1", a.model);
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("models/{name}.yaml")));
+    let name = out
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or(&name)
+        .to_string();
+    let config = KinoConfig {
+        kind,
+        members: a.members.unwrap_or(members),
+        hidden: a.hidden.clone(),
+        steps: a.steps,
+        batch: a.batch,
+        lr: a.lr,
+        lr_final: a.lr_final,
+        seed: a.seed,
+        eval_every: a.eval_every,
+    };
+    let run = KinoRun {
+        geometry: crate::kino_cmd::geometry_of(&a.data)?,
+        config: config.clone(),
+        name,
+        out,
+        data: a.data.clone(),
+        val: a.val.clone(),
+        dt: a.dt,
+        horizon: a.horizon,
+        summary: summary.into(),
+        command: command.into(),
+    };
+    let total = (config.steps * config.members) as u64;
+    let pb = bar(total, "training");
+    let quiet = !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let started = std::time::Instant::now();
+    let mut progress = |member: usize, step: usize, loss: f64| {
+        pb.set_position((member * config.steps + step) as u64);
+        if step.is_multiple_of(10) {
+            pb.set_message(format!("member {member} loss {loss:.4}"));
+        }
+        if quiet && (step.is_multiple_of(config.eval_every) || step == config.steps) {
+            eprintln!(
+                "member {member} step {step}/{}: loss {loss:.4} ({:.0} s)",
+                config.steps,
+                started.elapsed().as_secs_f64()
+            );
+        }
+    };
+    let t = learn_kino(&run, device, &mut progress)?;
+    pb.finish_and_clear();
+    println!(
+        "{}: {} training / {} validation examples; validation MSE (standardised) {:.4}",
+        t.file.card.name, t.train_examples, t.val_examples, t.report.val_loss
+    );
+    for acc in &t.accuracy {
+        for (label, e) in [("1 step", &acc.one_step[0]), ("multi", &acc.multi_step[0])] {
+            let r = e.rmse();
+            let cells: Vec<String> = OUTPUT_NAMES
+                .iter()
+                .zip(r)
+                .map(|(n, v)| format!("{n} {v:.3}"))
+                .collect();
+            println!("  {:>10} {label:>6}: {}", acc.predictor, cells.join(", "));
+        }
+    }
+    println!(
+        "wrote {} (+ {} network(s)), learning curve {}; {:.0} s",
+        run.out.display(),
+        t.file.networks.len(),
+        t.curve_png.display(),
+        t.report.wall_time_s
+    );
+    Ok(())
+}
