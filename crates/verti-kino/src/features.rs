@@ -13,6 +13,7 @@
 //! frame (behind the rear axle to one wheelbase ahead of the front, across the track).
 //! Output (6 values): the heading-frame pose change over one model step.
 
+use std::f64::consts::PI;
 use verti_bench::observation::Pose6;
 use verti_core::math::wrap_angle;
 use verti_world::Heightfield;
@@ -73,13 +74,67 @@ pub fn heading_delta(from: &Pose6, to: &Pose6) -> [f64; OUTPUT_DIM] {
 /// `pose` moved by a heading-frame change (world units): the inverse of [`heading_delta`].
 pub fn apply_delta(pose: &Pose6, d: &[f64; OUTPUT_DIM]) -> Pose6 {
     let (s, c) = pose.yaw.sin_cos();
+    apply_delta_sc(pose, d, (s, c))
+}
+
+/// [`apply_delta`] with the sine and cosine of `pose.yaw` already known (rollouts compute them
+/// once per step).
+#[inline]
+pub fn apply_delta_sc(pose: &Pose6, d: &[f64; OUTPUT_DIM], (s, c): (f64, f64)) -> Pose6 {
+    // one step turns by far less than a full turn: a conditional wrap instead of a remainder
+    let mut yaw = pose.yaw + d[3];
+    if !(-PI..PI).contains(&yaw) {
+        yaw = wrap_angle(yaw);
+    }
     Pose6 {
         x: pose.x + c * d[0] - s * d[1],
         y: pose.y + s * d[0] + c * d[1],
         z: pose.z + d[2],
-        yaw: wrap_angle(pose.yaw + d[3]),
+        yaw,
         roll: pose.roll + d[4],
         pitch: pose.pitch + d[5],
+    }
+}
+
+/// Terrain heights as [`Heightfield::height_at`] gives them (the same triangles, clamped at
+/// the edges), with the per-call constants hoisted: the probes run 12 times per rollout step.
+pub struct Ground<'a> {
+    heights: &'a [f64],
+    n: usize,
+    inv_cell: f64,
+    half: f64,
+    last: f64,
+}
+
+impl<'a> Ground<'a> {
+    pub fn new(hf: &'a Heightfield) -> Ground<'a> {
+        let n = hf.size();
+        Ground {
+            heights: hf.heights(),
+            n,
+            inv_cell: 1.0 / hf.cell(),
+            half: 0.5 * (n - 1) as f64,
+            last: (n - 1) as f64,
+        }
+    }
+
+    #[inline]
+    pub fn height(&self, x: f64, y: f64) -> f64 {
+        let gc = (x * self.inv_cell + self.half).clamp(0.0, self.last);
+        let gr = (self.half - y * self.inv_cell).clamp(0.0, self.last);
+        // non-negative after the clamp: truncation is the floor, without a library call
+        let c0 = (gc as usize).min(self.n - 2);
+        let r0 = (gr as usize).min(self.n - 2);
+        let u = gc - c0 as f64;
+        let v = 1.0 - (gr - r0 as f64);
+        let i = r0 * self.n + c0;
+        let (nw, ne) = (self.heights[i], self.heights[i + 1]);
+        let (sw, se) = (self.heights[i + self.n], self.heights[i + self.n + 1]);
+        if u >= v {
+            sw + u * (se - sw) + v * (ne - se)
+        } else {
+            sw + v * (nw - sw) + u * (ne - nw)
+        }
     }
 }
 
@@ -118,7 +173,8 @@ pub struct KinoState {
     pub last_delta: [f64; OUTPUT_DIM],
 }
 
-/// Writes the 22 raw (unnormalised) inputs for one step into `out`.
+/// Writes the 22 raw (unnormalised) inputs for one step into `out`; returns the sine and
+/// cosine of the heading, which the caller may reuse.
 ///
 /// `dt` is the model step in full-scale seconds; `command` is (target speed m/s in world units,
 /// steering); heights are read from `terrain` (the world's undeformed ground truth, as every
@@ -130,7 +186,7 @@ pub fn write_inputs(
     units: Units,
     dt: f64,
     out: &mut [f32],
-) {
+) -> (f64, f64) {
     let p = &state.pose;
     let d = units.delta_to_model(&state.last_delta);
     let inv_dt = 1.0 / dt;
@@ -150,17 +206,19 @@ pub fn write_inputs(
         *o = v as f32;
     }
     let (s, c) = p.yaw.sin_cos();
+    let ground = Ground::new(terrain);
     let inv_scale = 1.0 / units.scale;
     let mut i = STATE_DIM + COMMAND_DIM;
     for a in PROBE_AHEAD {
         let a = a * units.scale;
         for l in PROBE_LEFT {
             let l = l * units.scale;
-            let h = terrain.height_at(p.x + c * a - s * l, p.y + s * a + c * l);
+            let h = ground.height(p.x + c * a - s * l, p.y + s * a + c * l);
             out[i] = ((h - p.z) * inv_scale) as f32;
             i += 1;
         }
     }
+    (s, c)
 }
 
 /// Per-dimension standardisation: (x - mean) / std.
@@ -263,6 +321,24 @@ mod tests {
         let b = Pose6 { y: 2.0, ..a };
         let d = heading_delta(&a, &b);
         assert!((d[0] - 2.0).abs() < 1e-12 && d[1].abs() < 1e-12);
+    }
+
+    #[test]
+    fn ground_matches_the_heightfield() {
+        let n = 9;
+        let heights: Vec<f64> = (0..n * n).map(|i| ((i * 37 % 11) as f64) * 0.3).collect();
+        let hf = Heightfield::new(n, 1.5, heights);
+        let g = Ground::new(&hf);
+        let mut x = -7.0;
+        while x < 7.0 {
+            let mut y = -6.9;
+            while y < 7.0 {
+                let (a, b) = (g.height(x, y), hf.height_at(x, y));
+                assert!((a - b).abs() < 1e-12, "({x}, {y}): {a} vs {b}");
+                y += 0.37;
+            }
+            x += 0.41;
+        }
     }
 
     #[test]

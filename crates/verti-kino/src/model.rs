@@ -3,7 +3,8 @@
 
 use crate::card::{KinoFile, KinoKind};
 use crate::features::{
-    INPUT_DIM, KinoState, OUTPUT_DIM, Units, apply_delta, heading_delta, write_inputs,
+    Ground, INPUT_DIM, KinoState, OUTPUT_DIM, Units, apply_delta, apply_delta_sc, heading_delta,
+    write_inputs,
 };
 use std::sync::Arc;
 use verti_bench::observation::Pose6;
@@ -101,7 +102,7 @@ impl KinoModel {
         scratch: &mut StepScratch,
     ) -> KinoState {
         let dt = self.dt();
-        write_inputs(state, command, terrain, units, dt, &mut scratch.input);
+        let sc = write_inputs(state, command, terrain, units, dt, &mut scratch.input);
         let pose = &state.pose;
         let delta = match self.file.card.kind {
             KinoKind::Ensemble => {
@@ -115,9 +116,10 @@ impl KinoModel {
                 let dt_world = dt / units.time_factor();
                 let mut d = bicycle_delta(command, geometry, dt_world);
                 // z follows the ground: the ride height over the terrain is held
-                let ride = pose.z - terrain.height_at(pose.x, pose.y);
-                let next = apply_delta(pose, &d);
-                d[2] = terrain.height_at(next.x, next.y) + ride - pose.z;
+                let ground = Ground::new(terrain);
+                let ride = pose.z - ground.height(pose.x, pose.y);
+                let next = apply_delta_sc(pose, &d, sc);
+                d[2] = ground.height(next.x, next.y) + ride - pose.z;
                 // the network predicts the next attitude itself
                 d[4] = rp[0] - pose.roll;
                 d[5] = rp[1] - pose.pitch;
@@ -125,7 +127,7 @@ impl KinoModel {
             }
         };
         KinoState {
-            pose: apply_delta(pose, &delta),
+            pose: apply_delta_sc(pose, &delta, sc),
             last_delta: delta,
         }
     }
