@@ -39,8 +39,9 @@ impl<T: Copy> Crop<T> {
     }
 }
 
-/// Chassis pose: position of the reference point and Z-Y-X Euler angles (radians).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Chassis pose: position of the reference point and Z-Y-X Euler angles (radians). The
+/// default is the origin, level, facing +x.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Pose6 {
     pub x: f64,
     pub y: f64,

@@ -2,7 +2,7 @@
 //! training record, plus one verti-nn network file per network it is made of (ensemble
 //! members, heads).
 
-use crate::features::{INPUT_DIM, OUTPUT_DIM, Standardiser};
+use crate::features::{INPUT_DIM, OUTPUT_DIM};
 use crate::{KinoError, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -76,8 +76,6 @@ pub struct KinoCard {
 #[derive(Clone, Debug)]
 pub struct KinoFile {
     pub card: KinoCard,
-    pub input: Standardiser,
-    pub output: Standardiser,
     pub networks: Vec<Arc<Network>>,
     /// The networks as MLPs on raw inputs and raw outputs (the standardisation folded into
     /// their first and last layers).
@@ -153,14 +151,6 @@ impl KinoFile {
             mlps.push(folded);
         }
         Ok(KinoFile {
-            input: Standardiser {
-                mean: card.input_mean.clone(),
-                std: card.input_std.clone(),
-            },
-            output: Standardiser {
-                mean: card.output_mean.clone(),
-                std: card.output_std.clone(),
-            },
             card,
             networks,
             mlps,

@@ -3,8 +3,7 @@
 
 use crate::card::{KinoFile, KinoKind};
 use crate::features::{
-    Ground, INPUT_DIM, KinoState, OUTPUT_DIM, Units, apply_delta, apply_delta_sc, heading_delta,
-    write_inputs,
+    Ground, INPUT_DIM, KinoState, OUTPUT_DIM, Units, apply_delta_sc, heading_delta, write_inputs,
 };
 use std::sync::Arc;
 use verti_bench::observation::Pose6;
@@ -114,12 +113,7 @@ impl KinoModel {
                 let mut rp = [0.0; 2];
                 self.predict(scratch, &mut rp);
                 let dt_world = dt / units.time_factor();
-                let mut d = bicycle_delta(command, geometry, dt_world);
-                // z follows the ground: the ride height over the terrain is held
-                let ground = Ground::new(terrain);
-                let ride = pose.z - ground.height(pose.x, pose.y);
-                let next = apply_delta_sc(pose, &d, sc);
-                d[2] = ground.height(next.x, next.y) + ride - pose.z;
+                let mut d = bicycle_on_ground(pose, command, terrain, geometry, dt_world, sc);
                 // the network predicts the next attitude itself
                 d[4] = rp[0] - pose.roll;
                 d[5] = rp[1] - pose.pitch;
@@ -147,6 +141,24 @@ pub fn bicycle_delta(command: (f64, f64), g: Geometry, dt: f64) -> [f64; OUTPUT_
     [chord * c, chord * s, 0.0, wrap_angle(dpsi), 0.0, 0.0]
 }
 
+/// [`bicycle_delta`] with z following the ground: the ride height over the terrain is held.
+/// `sc` is the sine and cosine of `pose.yaw`. Roll and pitch changes are zero.
+fn bicycle_on_ground(
+    pose: &Pose6,
+    command: (f64, f64),
+    terrain: &Heightfield,
+    geometry: Geometry,
+    dt_world: f64,
+    sc: (f64, f64),
+) -> [f64; OUTPUT_DIM] {
+    let mut d = bicycle_delta(command, geometry, dt_world);
+    let ground = Ground::new(terrain);
+    let ride = pose.z - ground.height(pose.x, pose.y);
+    let next = apply_delta_sc(pose, &d, sc);
+    d[2] = ground.height(next.x, next.y) + ride - pose.z;
+    d
+}
+
 /// The bicycle as a model of the same shape as the learned ones: forward/left/yaw from the
 /// command, z held on the ground (ride height kept), roll and pitch held. The baseline every
 /// learned model is compared with.
@@ -158,12 +170,10 @@ pub fn bicycle_step(
     dt_world: f64,
 ) -> KinoState {
     let pose = &state.pose;
-    let mut d = bicycle_delta(command, geometry, dt_world);
-    let ride = pose.z - terrain.height_at(pose.x, pose.y);
-    let next = apply_delta(pose, &d);
-    d[2] = terrain.height_at(next.x, next.y) + ride - pose.z;
+    let sc = pose.yaw.sin_cos();
+    let d = bicycle_on_ground(pose, command, terrain, geometry, dt_world, sc);
     KinoState {
-        pose: apply_delta(pose, &d),
+        pose: apply_delta_sc(pose, &d, sc),
         last_delta: d,
     }
 }

@@ -18,7 +18,7 @@ pub struct LearnedRollout {
     scratch: StepScratch,
     units: Units,
     geometry: Geometry,
-    /// The world's ground, copied when the world changes (a 129 x 129 grid: ~130 kB).
+    /// The trial's ground, copied at its first plan (a 129 x 129 grid: ~130 kB).
     terrain: Option<Heightfield>,
     /// Recent observed poses, to form the rates of the first rollout step as training did:
     /// from the pose one model step ago.
@@ -36,14 +36,7 @@ impl LearnedRollout {
             terrain: None,
             history: VecDeque::new(),
             start: KinoState {
-                pose: Pose6 {
-                    x: 0.0,
-                    y: 0.0,
-                    z: 0.0,
-                    roll: 0.0,
-                    pitch: 0.0,
-                    yaw: 0.0,
-                },
+                pose: Pose6::default(),
                 last_delta: [0.0; OUTPUT_DIM],
             },
         }
@@ -62,12 +55,12 @@ impl RolloutModel for LearnedRollout {
             max_steer: task.max_steer_angle.max(1e-3),
         };
         self.history.clear();
+        self.terrain = None;
     }
 
     fn prepare(&mut self, obs: &Observation, _ctx: &PlanContext) {
-        let ground = &obs.world().terrain;
-        if self.terrain.as_ref() != Some(ground) {
-            self.terrain = Some(ground.clone());
+        if self.terrain.is_none() {
+            self.terrain = Some(obs.world().terrain.clone());
         }
         let dt = self.dt_world();
         let now = obs.time;

@@ -59,21 +59,12 @@ pub struct Rollouts {
     channels: Vec<(&'static str, Vec<f64>)>,
 }
 
-const ORIGIN: Pose6 = Pose6 {
-    x: 0.0,
-    y: 0.0,
-    z: 0.0,
-    roll: 0.0,
-    pitch: 0.0,
-    yaw: 0.0,
-};
-
 impl Rollouts {
     /// Sizes every buffer for K × H (reusing the allocations of earlier plans).
     pub fn resize(&mut self, samples: usize, horizon: usize) {
         self.samples = samples;
         self.horizon = horizon;
-        self.poses.resize(samples * horizon, ORIGIN);
+        self.poses.resize(samples * horizon, Pose6::default());
         for (_, c) in &mut self.channels {
             c.resize(samples * horizon, 0.0);
         }
