@@ -34,14 +34,14 @@ pub struct KinoArgs {
     /// Model step, full-scale seconds (a multiple of the data's row period).
     #[arg(long, default_value_t = 0.2)]
     pub dt: f64,
-    /// Ensemble members (default: 3 for mppi6, 1 for wmvct).
+    /// Ensemble members (default: 2 for mppi6, 1 for wmvct).
     #[arg(long)]
     pub members: Option<usize>,
     /// Hidden layer widths, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "32,32")]
     pub hidden: Vec<usize>,
     /// Optimiser steps per member.
-    #[arg(long, default_value_t = 4000)]
+    #[arg(long, default_value_t = 6000)]
     pub steps: usize,
     #[arg(long, default_value_t = 256)]
     pub batch: usize,

@@ -35,11 +35,7 @@ const SHIPPED: &[Embedded] = &[
     Embedded {
         card: include_str!("../../../models/mppi6-v1.yaml"),
         path: "models/mppi6-v1.yaml",
-        networks: &[
-            net!("mppi6-v1.net0"),
-            net!("mppi6-v1.net1"),
-            net!("mppi6-v1.net2"),
-        ],
+        networks: &[net!("mppi6-v1.net0"), net!("mppi6-v1.net1")],
     },
     Embedded {
         card: include_str!("../../../models/wmvct-v1.yaml"),

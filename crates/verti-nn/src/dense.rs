@@ -57,6 +57,59 @@ impl Dense {
     }
 }
 
+fn avx_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Output blocks summed together in one pass over the inputs.
+const GROUP: usize = 4;
+
+/// `G` output blocks of one layer: `w` is G × [inputs][BLOCK], `b` and `y` G × BLOCK.
+/// Every output is its bias plus its inputs' products in ascending order, as in
+/// [`Network::forward`].
+#[inline(always)]
+fn dense_group<const G: usize>(
+    x: &[f32],
+    w: &[f32],
+    b: &[f32],
+    activation: Activation,
+    y: &mut [f32],
+) {
+    let inputs = x.len();
+    let mut acc = [[0.0f32; BLOCK]; G];
+    for (g, a) in acc.iter_mut().enumerate() {
+        a.copy_from_slice(&b[g * BLOCK..(g + 1) * BLOCK]);
+    }
+    for (i, &xi) in x.iter().enumerate() {
+        for (g, a) in acc.iter_mut().enumerate() {
+            let wi = &w[(g * inputs + i) * BLOCK..(g * inputs + i + 1) * BLOCK];
+            for j in 0..BLOCK {
+                a[j] += xi * wi[j];
+            }
+        }
+    }
+    for (a, y) in acc.iter_mut().zip(y.chunks_exact_mut(BLOCK)) {
+        match activation {
+            Activation::Identity => {}
+            Activation::Relu => a.iter_mut().for_each(|v| *v = v.max(0.0)),
+            Activation::LeakyRelu(s) => a.iter_mut().for_each(|v| {
+                if *v < 0.0 {
+                    *v *= s
+                }
+            }),
+            Activation::Tanh => a.iter_mut().for_each(|v| *v = libm::tanhf(*v)),
+        }
+        y.copy_from_slice(a);
+    }
+}
+
 /// A layer in the evaluation layout.
 #[derive(Clone, Debug)]
 struct Blocked {
@@ -74,6 +127,8 @@ pub struct Mlp {
     /// The same, laid out for evaluation.
     blocked: Vec<Blocked>,
     widest: usize,
+    /// Whether this CPU runs the 256-bit build of the kernel.
+    avx: bool,
 }
 
 /// Two work buffers as wide as the widest layer; one per thread.
@@ -154,6 +209,7 @@ impl Mlp {
             layers,
             blocked,
             widest,
+            avx: avx_available(),
         }
     }
 
@@ -202,6 +258,15 @@ impl Mlp {
         Ok(Mlp::from_layers(layers))
     }
 
+    /// The same network evaluated by the baseline (128-bit) build of the kernel, whatever the
+    /// CPU: for checking that both builds agree bit for bit.
+    pub fn portable(&self) -> Mlp {
+        Mlp {
+            avx: false,
+            ..self.clone()
+        }
+    }
+
     pub fn inputs(&self) -> usize {
         self.layers[0].inputs
     }
@@ -228,36 +293,45 @@ impl Mlp {
         if scratch.a.len() < self.widest {
             *scratch = self.scratch();
         }
+        #[cfg(target_arch = "x86_64")]
+        if self.avx {
+            // SAFETY: `avx` is set only where the CPU reported AVX at construction.
+            unsafe { self.forward_avx(input, scratch, out) };
+            return;
+        }
+        self.forward_body(input, scratch, out);
+    }
+
+    /// The same code compiled for 256-bit registers. Separate multiplies and adds (Rust never
+    /// contracts them into FMA), so the results are bit-identical to the baseline build.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn forward_avx(&self, input: &[f32], scratch: &mut MlpScratch, out: &mut [f32]) {
+        self.forward_body(input, scratch, out);
+    }
+
+    #[inline(always)]
+    fn forward_body(&self, input: &[f32], scratch: &mut MlpScratch, out: &mut [f32]) {
         let (mut cur, mut next) = (&mut scratch.a, &mut scratch.b);
         cur[..input.len()].copy_from_slice(input);
         for layer in &self.blocked {
             let x = &cur[..layer.inputs];
             let col = layer.inputs * BLOCK;
-            for ((w, b), y) in layer
-                .weights
-                .chunks_exact(col)
-                .zip(layer.bias.chunks_exact(BLOCK))
-                .zip(next.chunks_exact_mut(BLOCK))
-            {
-                // bias first, then inputs ascending: Network::forward's order for every output
-                let mut acc = [0.0f32; BLOCK];
-                acc.copy_from_slice(b);
-                for (xi, wi) in x.iter().zip(w.chunks_exact(BLOCK)) {
-                    for j in 0..BLOCK {
-                        acc[j] += xi * wi[j];
-                    }
+            let blocks = layer.bias.len() / BLOCK;
+            let mut first = 0;
+            while first < blocks {
+                // up to GROUP blocks at once: independent sums hide the adds' latency
+                let g = (blocks - first).min(GROUP);
+                let w = &layer.weights[first * col..(first + g) * col];
+                let b = &layer.bias[first * BLOCK..(first + g) * BLOCK];
+                let y = &mut next[first * BLOCK..(first + g) * BLOCK];
+                match g {
+                    4 => dense_group::<4>(x, w, b, layer.activation, y),
+                    3 => dense_group::<3>(x, w, b, layer.activation, y),
+                    2 => dense_group::<2>(x, w, b, layer.activation, y),
+                    _ => dense_group::<1>(x, w, b, layer.activation, y),
                 }
-                match layer.activation {
-                    Activation::Identity => {}
-                    Activation::Relu => acc.iter_mut().for_each(|v| *v = v.max(0.0)),
-                    Activation::LeakyRelu(s) => acc.iter_mut().for_each(|v| {
-                        if *v < 0.0 {
-                            *v *= s
-                        }
-                    }),
-                    Activation::Tanh => acc.iter_mut().for_each(|v| *v = libm::tanhf(*v)),
-                }
-                y.copy_from_slice(&acc);
+                first += g;
             }
             std::mem::swap(&mut cur, &mut next);
         }

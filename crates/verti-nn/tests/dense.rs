@@ -65,6 +65,13 @@ fn mlp_matches_the_network_bit_for_bit() {
             .zip(&want)
             .all(|(a, b)| a.to_bits() == b.to_bits());
         assert!(same, "{out:?} vs {want:?}");
+        // the baseline build of the kernel (used where the CPU has no AVX) agrees too
+        let portable = mlp.portable().forward(&x);
+        let same = portable
+            .iter()
+            .zip(&want)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(same, "{portable:?} vs {want:?}");
     }
 }
 
