@@ -12,15 +12,16 @@ pub enum LearnCommand {
     Swae(SwaeArgs),
     /// Train the local-patch terrain encoder (`patch-v1`) on crops from training worlds.
     Patch(PatchArgs),
-    /// Train a learned kinodynamic model (`mppi6`, `wmvct`) on random-exploration data.
+    /// Train a learned kinodynamic model (`mppi6`, `wmvct`, `tal`) on random-exploration data.
     Kino(KinoArgs),
 }
 
 #[derive(Args)]
 pub struct KinoArgs {
-    /// Which model: mppi6 (an ensemble predicting the full 6-DoF change) or wmvct (bicycle
-    /// for x/y/yaw, terrain for z, a network for roll and pitch).
-    #[arg(long, value_parser = ["mppi6", "wmvct"])]
+    /// Which model: mppi6 (an ensemble predicting the full 6-DoF change), wmvct (bicycle
+    /// for x/y/yaw, terrain for z, a network for roll and pitch) or tal (an elevation map
+    /// encoded once per plan, gated by the vehicle's offset within it).
+    #[arg(long, value_parser = ["mppi6", "wmvct", "tal"])]
     pub model: String,
     /// Training dataset (`verti data generate random --worlds verti-100-s1 ...`).
     #[arg(long, default_value = "data/random-s1")]
@@ -34,7 +35,7 @@ pub struct KinoArgs {
     /// Model step, full-scale seconds (a multiple of the data's row period).
     #[arg(long, default_value_t = 0.2)]
     pub dt: f64,
-    /// Ensemble members (default: 2 for mppi6, 1 for wmvct).
+    /// Ensemble members (default: 2 for mppi6, 1 otherwise).
     #[arg(long)]
     pub members: Option<usize>,
     /// Hidden layer widths, comma-separated.

@@ -18,6 +18,13 @@ pub fn run(a: &KinoArgs, command: &str, device: &Device) -> Result<(), String> {
             "MPPI-6's model: an ensemble of MLPs predicting the full 6-DoF pose change over one \
              step from attitude, pose rates, command and the terrain under and ahead",
         ),
+        "tal" => (
+            KinoKind::Attentive,
+            1,
+            "TAL's model: a heading-aligned elevation map around the vehicle encoded once per \
+             plan, its features gated by the vehicle's offset within the map, and a dynamics \
+             network predicting the 6-DoF change from gated features, attitude, rates and command",
+        ),
         _ => (
             KinoKind::Decomposed,
             1,

@@ -2,6 +2,7 @@
 //! training record, plus one verti-nn network file per network it is made of (ensemble
 //! members, heads).
 
+use crate::attentive::{ATTENTIVE_INPUT_DIM, HEAD_DIM, MAP_DIM, OFFSET_DIM};
 use crate::features::{INPUT_DIM, OUTPUT_DIM};
 use crate::{KinoError, Result};
 use serde::{Deserialize, Serialize};
@@ -23,14 +24,25 @@ pub enum KinoKind {
     /// WMVCT: a kinematic bicycle for forward/left/yaw, the terrain height for z, and a
     /// network for the next roll and pitch (absolute, not a change).
     Decomposed,
+    /// TAL: an elevation-map encoder run once per plan, a gate on its features from the
+    /// vehicle's offset within the map, and a dynamics network (networks in that order; see
+    /// [`crate::attentive`]).
+    Attentive,
 }
 
 impl KinoKind {
     /// Outputs each network predicts.
     pub fn network_outputs(self) -> usize {
         match self {
-            KinoKind::Ensemble => OUTPUT_DIM,
+            KinoKind::Ensemble | KinoKind::Attentive => OUTPUT_DIM,
             KinoKind::Decomposed => 2,
+        }
+    }
+    /// Raw input columns the card standardises.
+    pub fn input_dim(self) -> usize {
+        match self {
+            KinoKind::Ensemble | KinoKind::Decomposed => INPUT_DIM,
+            KinoKind::Attentive => ATTENTIVE_INPUT_DIM,
         }
     }
 }
@@ -104,8 +116,8 @@ impl KinoFile {
         }
         let outputs = card.kind.network_outputs();
         for (field, v, n) in [
-            ("input_mean", &card.input_mean, INPUT_DIM),
-            ("input_std", &card.input_std, INPUT_DIM),
+            ("input_mean", &card.input_mean, card.kind.input_dim()),
+            ("input_std", &card.input_std, card.kind.input_dim()),
             ("output_mean", &card.output_mean, outputs),
             ("output_std", &card.output_std, outputs),
         ] {
@@ -125,31 +137,28 @@ impl KinoFile {
                 format!("{} listed, {} loaded", card.networks.len(), networks.len()),
             ));
         }
-        let mut mlps = Vec::new();
-        for (file, net) in card.networks.iter().zip(&networks) {
-            let mlp =
-                Mlp::from_network(net).map_err(|e| bad("networks", format!("{file}: {e}")))?;
-            if mlp.inputs() != INPUT_DIM || mlp.outputs() != outputs {
-                return Err(bad(
-                    "networks",
-                    format!(
-                        "{file} maps {} inputs to {}, a {:?} model needs {INPUT_DIM} to {outputs}",
-                        mlp.inputs(),
-                        mlp.outputs(),
-                        card.kind
-                    ),
-                ));
+        let mlps = match card.kind {
+            KinoKind::Ensemble | KinoKind::Decomposed => {
+                let mut mlps = Vec::new();
+                for (file, net) in card.networks.iter().zip(&networks) {
+                    let mlp = as_mlp(file, net, INPUT_DIM, Some(outputs), card.kind)
+                        .map_err(|e| bad("networks", e))?;
+                    let folded = mlp
+                        .fold_standardisation(
+                            &card.input_mean,
+                            &card.input_std,
+                            &card.output_mean,
+                            &card.output_std,
+                        )
+                        .map_err(|e| bad("networks", format!("{file}: {e}")))?;
+                    mlps.push(folded);
+                }
+                mlps
             }
-            let folded = mlp
-                .fold_standardisation(
-                    &card.input_mean,
-                    &card.input_std,
-                    &card.output_mean,
-                    &card.output_std,
-                )
-                .map_err(|e| bad("networks", format!("{file}: {e}")))?;
-            mlps.push(folded);
-        }
+            KinoKind::Attentive => {
+                fold_attentive(&card, &networks).map_err(|e| bad("networks", e))?
+            }
+        };
         Ok(KinoFile {
             card,
             networks,
@@ -200,6 +209,67 @@ impl KinoFile {
         })?;
         std::fs::write(path, text).map_err(|e| io(path.to_path_buf(), e))
     }
+}
+
+/// A network as an MLP with the given input (and output) width.
+fn as_mlp(
+    file: &str,
+    net: &Network,
+    inputs: usize,
+    outputs: Option<usize>,
+    kind: KinoKind,
+) -> std::result::Result<Mlp, String> {
+    let mlp = Mlp::from_network(net).map_err(|e| format!("{file}: {e}"))?;
+    if mlp.inputs() != inputs || outputs.is_some_and(|o| mlp.outputs() != o) {
+        return Err(format!(
+            "{file} maps {} inputs to {}, a {kind:?} model needs {inputs} to {}",
+            mlp.inputs(),
+            mlp.outputs(),
+            outputs.map_or("its features".to_string(), |o| o.to_string())
+        ));
+    }
+    Ok(mlp)
+}
+
+/// TAL's three networks with the card's standardisation folded in: the map columns into the
+/// encoder, the offset columns into the gate, the head columns (and the outputs) into the
+/// dynamics network, whose gated-feature inputs are not standardised.
+fn fold_attentive(
+    card: &KinoCard,
+    networks: &[Arc<Network>],
+) -> std::result::Result<Vec<Mlp>, String> {
+    let [enc, gate, dynamics] = networks else {
+        return Err(format!(
+            "an attentive model has 3 networks (encoder, gate, dynamics), not {}",
+            networks.len()
+        ));
+    };
+    let files = &card.networks;
+    let kind = card.kind;
+    let enc = as_mlp(&files[0], enc, MAP_DIM, None, kind)?;
+    let features = enc.outputs();
+    let gate = as_mlp(&files[1], gate, OFFSET_DIM, Some(features), kind)?;
+    let dynamics = as_mlp(
+        &files[2],
+        dynamics,
+        features + HEAD_DIM,
+        Some(OUTPUT_DIM),
+        kind,
+    )?;
+    let (m, s) = (&card.input_mean, &card.input_std);
+    let head = MAP_DIM + OFFSET_DIM..;
+    let mut dyn_mean = vec![0.0; features];
+    dyn_mean.extend_from_slice(&m[head.clone()]);
+    let mut dyn_std = vec![1.0; features];
+    dyn_std.extend_from_slice(&s[head]);
+    Ok(vec![
+        enc.fold_inputs(&m[..MAP_DIM], &s[..MAP_DIM])?,
+        gate.fold_inputs(
+            &m[MAP_DIM..MAP_DIM + OFFSET_DIM],
+            &s[MAP_DIM..MAP_DIM + OFFSET_DIM],
+        )?,
+        dynamics.fold_standardisation(&dyn_mean, &dyn_std, &card.output_mean, &card.output_std)?,
+    ])
 }
 
 /// Parses a card's YAML, naming the file in errors.

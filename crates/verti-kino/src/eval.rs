@@ -97,6 +97,9 @@ pub fn evaluate(
         let mut t = 1;
         while t + horizon < tr.poses.len() {
             let mut state = state_from(&tr.poses[t - 1], &tr.poses[t]);
+            if let (Predictor::Model(m), Some(s)) = (predictor, scratch.as_mut()) {
+                m.begin(&tr.poses[t], terrain, data.units, s);
+            }
             for k in 0..horizon {
                 let command = tr.commands[t + k];
                 state = match (predictor, scratch.as_mut()) {

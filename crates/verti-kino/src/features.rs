@@ -241,20 +241,9 @@ pub struct KinoState {
     pub last_delta: [f64; OUTPUT_DIM],
 }
 
-/// Writes the 22 raw (unnormalised) inputs for one step into `out`; returns the sine and
-/// cosine of the heading, which the caller may reuse.
-///
-/// `dt` is the model step in full-scale seconds; `command` is (target speed m/s in world units,
-/// steering); heights are read from `terrain` (the world's undeformed ground truth, as every
-/// Verti-Bench system gets it).
-pub fn write_inputs(
-    state: &KinoState,
-    command: (f64, f64),
-    terrain: &Heightfield,
-    units: Units,
-    dt: f64,
-    out: &mut [f32],
-) -> (f64, f64) {
+/// The attitude, pose rates and command part of the inputs (the first
+/// `STATE_DIM + COMMAND_DIM` values), raw; shared by every model kind.
+pub fn write_head(state: &KinoState, command: (f64, f64), units: Units, dt: f64, out: &mut [f32]) {
     let p = &state.pose;
     let d = units.delta_to_model(&state.last_delta);
     let inv_dt = 1.0 / dt;
@@ -273,6 +262,24 @@ pub fn write_inputs(
     for (o, v) in out.iter_mut().zip(head) {
         *o = v as f32;
     }
+}
+
+/// Writes the 22 raw (unnormalised) inputs for one step into `out`; returns the sine and
+/// cosine of the heading, which the caller may reuse.
+///
+/// `dt` is the model step in full-scale seconds; `command` is (target speed m/s in world units,
+/// steering); heights are read from `terrain` (the world's undeformed ground truth, as every
+/// Verti-Bench system gets it).
+pub fn write_inputs(
+    state: &KinoState,
+    command: (f64, f64),
+    terrain: &Heightfield,
+    units: Units,
+    dt: f64,
+    out: &mut [f32],
+) -> (f64, f64) {
+    write_head(state, command, units, dt, out);
+    let p = &state.pose;
     let (s, c) = p.yaw.sin_cos();
     let mut heights = [0.0; TERRAIN_DIM];
     Ground::new(terrain).probe(p, (s, c), units.scale, &mut heights);

@@ -10,6 +10,7 @@
 
 use std::path::PathBuf;
 
+pub mod attentive;
 pub mod card;
 pub mod eval;
 pub mod features;

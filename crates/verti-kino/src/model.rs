@@ -1,9 +1,11 @@
 //! One step of a learned kinodynamic model, in world units: used alike by MPPI's rollouts, by
 //! the accuracy evaluation and (through [`crate::features`]) by training.
 
+use crate::attentive::{MapContext, squash, write_map, write_offset};
 use crate::card::{KinoFile, KinoKind};
 use crate::features::{
-    Ground, INPUT_DIM, KinoState, OUTPUT_DIM, Units, apply_delta_sc, heading_delta, write_inputs,
+    Ground, INPUT_DIM, KinoState, OUTPUT_DIM, Units, apply_delta_sc, heading_delta, write_head,
+    write_inputs,
 };
 use std::sync::Arc;
 use verti_bench::observation::Pose6;
@@ -35,6 +37,8 @@ pub struct StepScratch {
     out: Vec<f32>,
     sum: Vec<f32>,
     mlp: MlpScratch,
+    /// An attentive model's map, set by [`KinoModel::begin`].
+    map: MapContext,
 }
 
 /// A loaded model, cheap to clone (the file is shared).
@@ -64,12 +68,64 @@ impl KinoModel {
 
     pub fn scratch(&self) -> StepScratch {
         let n = self.file.card.kind.network_outputs();
+        let widest = self
+            .file
+            .mlps
+            .iter()
+            .max_by_key(|m| m.inputs().max(m.outputs()));
         StepScratch {
             input: [0.0; INPUT_DIM],
             out: vec![0.0; n],
             sum: vec![0.0; n],
-            mlp: self.file.mlps[0].scratch(),
+            mlp: widest.map(|m| m.scratch()).unwrap_or_default(),
+            map: MapContext::new(match self.file.card.kind {
+                KinoKind::Attentive => self.file.mlps[0].outputs(),
+                _ => 0,
+            }),
         }
+    }
+
+    /// Starts a plan (or an open-loop prediction) from `reference`: an attentive model encodes
+    /// the terrain map around it, once, for every step that follows; other kinds need nothing.
+    pub fn begin(
+        &self,
+        reference: &Pose6,
+        terrain: &Heightfield,
+        units: Units,
+        scratch: &mut StepScratch,
+    ) {
+        if self.file.card.kind != KinoKind::Attentive {
+            return;
+        }
+        let m = &mut scratch.map;
+        write_map(reference, terrain, units, &mut m.map);
+        self.file.mlps[0].forward_into(&m.map, &mut scratch.mlp, &mut m.features);
+        m.reference = Some(*reference);
+    }
+
+    /// An attentive model's change over one step (full-scale units), from the map features
+    /// gated by the offset and the head.
+    fn attentive_delta(
+        &self,
+        state: &KinoState,
+        command: (f64, f64),
+        units: Units,
+        scratch: &mut StepScratch,
+    ) -> [f64; OUTPUT_DIM] {
+        let f = &*self.file;
+        let m = &mut scratch.map;
+        let reference = m
+            .reference
+            .expect("KinoModel::begin runs before an attentive model steps");
+        write_offset(&reference, &state.pose, units, &mut m.offset);
+        f.mlps[1].forward_into(&m.offset, &mut scratch.mlp, &mut m.gate);
+        let n = m.features.len();
+        for ((x, e), g) in m.dynamics_in[..n].iter_mut().zip(&m.features).zip(&m.gate) {
+            *x = e * squash(*g);
+        }
+        write_head(state, command, units, f.card.dt, &mut m.dynamics_in[n..]);
+        f.mlps[2].forward_into(&m.dynamics_in, &mut scratch.mlp, &mut m.out);
+        m.out.map(f64::from)
     }
 
     /// The networks' mean prediction for the raw inputs in `scratch.input`, into `out` (the
@@ -90,7 +146,8 @@ impl KinoModel {
     }
 
     /// The state one model step later under `command` (target speed m/s, steering), world
-    /// units. `terrain` is the world's (undeformed) ground.
+    /// units. `terrain` is the world's (undeformed) ground. An attentive model steps from the
+    /// map of the last [`KinoModel::begin`].
     pub fn step(
         &self,
         state: &KinoState,
@@ -101,15 +158,16 @@ impl KinoModel {
         scratch: &mut StepScratch,
     ) -> KinoState {
         let dt = self.dt();
-        let sc = write_inputs(state, command, terrain, units, dt, &mut scratch.input);
         let pose = &state.pose;
-        let delta = match self.file.card.kind {
+        let (delta, sc) = match self.file.card.kind {
             KinoKind::Ensemble => {
+                let sc = write_inputs(state, command, terrain, units, dt, &mut scratch.input);
                 let mut d = [0.0; OUTPUT_DIM];
                 self.predict(scratch, &mut d);
-                units.delta_to_world(&d)
+                (units.delta_to_world(&d), sc)
             }
             KinoKind::Decomposed => {
+                let sc = write_inputs(state, command, terrain, units, dt, &mut scratch.input);
                 let mut rp = [0.0; 2];
                 self.predict(scratch, &mut rp);
                 let dt_world = dt / units.time_factor();
@@ -117,7 +175,11 @@ impl KinoModel {
                 // the network predicts the next attitude itself
                 d[4] = rp[0] - pose.roll;
                 d[5] = rp[1] - pose.pitch;
-                d
+                (d, sc)
+            }
+            KinoKind::Attentive => {
+                let d = self.attentive_delta(state, command, units, scratch);
+                (units.delta_to_world(&d), pose.yaw.sin_cos())
             }
         };
         KinoState {

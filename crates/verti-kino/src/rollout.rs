@@ -85,6 +85,8 @@ impl RolloutModel for LearnedRollout {
             .as_ref()
             .expect("LearnedRollout::prepare runs before rollout");
         let h = controls.horizon;
+        self.model
+            .begin(&self.start.pose, terrain, self.units, &mut self.scratch);
         for s in 0..controls.samples {
             let mut state = self.start;
             let u = &controls.controls[s * h..(s + 1) * h];

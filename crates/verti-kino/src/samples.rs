@@ -1,8 +1,15 @@
 //! Training and evaluation examples from a verti dataset: trajectories at the model step, and
 //! (input, target) pairs built with the same feature code the planners use.
 
+use crate::attentive::{ATTENTIVE_INPUT_DIM, write_row};
+use crate::card::KinoKind;
 use crate::features::{INPUT_DIM, KinoState, OUTPUT_DIM, Units, heading_delta, write_inputs};
 use crate::{KinoError, Result};
+use verti_core::Rng;
+
+/// Longest lag between an attentive model's map and its step in training: MPPI's horizon
+/// (20 steps), so every step of a rollout is inside what training saw.
+pub const MAX_LAG: usize = 20;
 use std::path::Path;
 use std::sync::Arc;
 use verti_bench::observation::Pose6;
@@ -39,6 +46,8 @@ pub struct KinoData {
 /// Input and target rows (row-major) and the level of each.
 #[derive(Clone, Debug, Default)]
 pub struct Examples {
+    /// Values per input row.
+    pub dim: usize,
     pub inputs: Vec<f32>,
     pub targets: Vec<f32>,
     pub levels: Vec<ElevationLevel>,
@@ -139,7 +148,10 @@ impl KinoData {
     /// One-step examples: for every pose with a predecessor and a successor, the model input
     /// and the full-scale heading-frame change to the next pose.
     pub fn examples(&self) -> Examples {
-        let mut ex = Examples::default();
+        let mut ex = Examples {
+            dim: INPUT_DIM,
+            ..Default::default()
+        };
         let mut input = [0.0f32; INPUT_DIM];
         for tr in &self.trajectories {
             let terrain = &self.worlds[tr.world].terrain;
@@ -165,6 +177,52 @@ impl KinoData {
             }
         }
         debug_assert_eq!(ex.targets.len(), ex.len() * OUTPUT_DIM);
+        ex
+    }
+
+    /// The examples a model of `kind` trains on (`seed` draws the attentive model's lags).
+    pub fn examples_for(&self, kind: KinoKind, seed: u64) -> Examples {
+        match kind {
+            KinoKind::Ensemble | KinoKind::Decomposed => self.examples(),
+            KinoKind::Attentive => self.attentive_examples(MAX_LAG, seed),
+        }
+    }
+
+    /// One-step examples for an attentive model: each pose's map is the one seen from a pose
+    /// up to `max_lag` − 1 steps earlier on the same trajectory (drawn uniformly), as a
+    /// rollout step sees the map encoded at the start of its plan.
+    pub fn attentive_examples(&self, max_lag: usize, seed: u64) -> Examples {
+        let mut ex = Examples {
+            dim: ATTENTIVE_INPUT_DIM,
+            ..Default::default()
+        };
+        let mut input = [0.0f32; ATTENTIVE_INPUT_DIM];
+        for (i, tr) in self.trajectories.iter().enumerate() {
+            let terrain = &self.worlds[tr.world].terrain;
+            let mut rng = Rng::derive(seed, "attentive-lag", i as u64);
+            for t in 1..tr.poses.len() - 1 {
+                let lag = rng.below(max_lag.max(1).min(t + 1) as u64) as usize;
+                let state = KinoState {
+                    pose: tr.poses[t],
+                    last_delta: heading_delta(&tr.poses[t - 1], &tr.poses[t]),
+                };
+                write_row(
+                    &tr.poses[t - lag],
+                    &state,
+                    tr.commands[t],
+                    terrain,
+                    self.units,
+                    self.dt,
+                    &mut input,
+                );
+                let d = self
+                    .units
+                    .delta_to_model(&heading_delta(&tr.poses[t], &tr.poses[t + 1]));
+                ex.inputs.extend_from_slice(&input);
+                ex.targets.extend(d.iter().map(|&v| v as f32));
+                ex.levels.push(tr.level);
+            }
+        }
         ex
     }
 }

@@ -42,6 +42,15 @@ const SHIPPED: &[Embedded] = &[
         path: "models/wmvct-v1.yaml",
         networks: &[net!("wmvct-v1.net0")],
     },
+    Embedded {
+        card: include_str!("../../../models/tal-v1.yaml"),
+        path: "models/tal-v1.yaml",
+        networks: &[
+            net!("tal-v1.encoder"),
+            net!("tal-v1.gate"),
+            net!("tal-v1.dynamics"),
+        ],
+    },
 ];
 
 fn load(e: &Embedded) -> Result<Arc<KinoFile>, String> {
@@ -91,6 +100,13 @@ pub fn systems() -> Vec<LearnedSystem> {
             "WMVCT: MPPI over a decomposed model (bicycle x/y/yaw, terrain z, learned \
              roll/pitch: wmvct-v1), cost on goal distance, obstacles and predicted roll/pitch",
             || model("wmvct-v1"),
+        ),
+        LearnedSystem::new(
+            "tal",
+            "TAL: MPPI over a terrain-attentive 6-DoF model (tal-v1: an elevation map encoded \
+             once per plan, gated by the vehicle's offset within it), cost on goal distance, \
+             obstacles and predicted roll/pitch",
+            || model("tal-v1"),
         ),
     ]
 }

@@ -87,7 +87,7 @@ impl KinoConfig {
 /// accumulate the drift that integrating predicted changes does).
 fn pick_targets(kind: KinoKind, input: &[f32], delta: &[f32]) -> Vec<f32> {
     match kind {
-        KinoKind::Ensemble => delta.to_vec(),
+        KinoKind::Ensemble | KinoKind::Attentive => delta.to_vec(),
         KinoKind::Decomposed => vec![input[0] + delta[4], input[1] + delta[5]],
     }
 }
@@ -124,7 +124,7 @@ fn standardise(
     Standardised { x, y, n: ex.len() }
 }
 
-fn rows(data: &[f32], dim: usize, idx: &[usize], device: &Device) -> Tensor<2> {
+pub(crate) fn rows(data: &[f32], dim: usize, idx: &[usize], device: &Device) -> Tensor<2> {
     let mut v = Vec::with_capacity(idx.len() * dim);
     for &i in idx {
         v.extend_from_slice(&data[i * dim..(i + 1) * dim]);
@@ -174,8 +174,47 @@ pub struct KinoProvenance {
     pub command: String,
 }
 
+/// A trained burn network as a verti-nn network named `file` (its card records provenance;
+/// the normalisation lives in the kinodynamic card).
+pub(crate) fn export_network(
+    net: &SeqNet,
+    file: &str,
+    summary: &str,
+    cfg: &KinoConfig,
+    prov: &KinoProvenance,
+    wall: f64,
+) -> Result<Arc<Network>, String> {
+    let card = ModelCard {
+        name: file.to_string(),
+        format: verti_nn::card::CARD_FORMAT,
+        summary: summary.to_string(),
+        input: net.input_shape(),
+        layers: net.layers().to_vec(),
+        normalisation: format!("see {}.yaml", prov.name),
+        weights: WeightsInfo {
+            file: format!("{file}.bin"),
+            floats: 0,
+            fnv1a64: String::new(),
+        },
+        training: TrainingInfo {
+            data: prov.data.clone(),
+            command: prov.command.clone(),
+            seed: cfg.seed,
+            steps: cfg.steps as u64,
+            wall_time_s: wall,
+            verti_version: format!("verti {}", env!("CARGO_PKG_VERSION")),
+            settings: String::new(),
+        },
+        metrics: BTreeMap::new(),
+        constants: BTreeMap::new(),
+    };
+    Network::from_params(card, &net.export_params())
+        .map(Arc::new)
+        .map_err(|e| e.to_string())
+}
+
 /// Trains a model on `train`, validating on `val`; `progress(member, step, loss)` after every
-/// step.
+/// step. Attentive models (TAL) train in [`crate::tal`].
 pub fn train(
     cfg: &KinoConfig,
     train_set: &Examples,
@@ -187,6 +226,9 @@ pub fn train(
     cfg.validate()?;
     if train_set.is_empty() || val_set.is_empty() {
         return Err("training and validation sets must both hold examples".into());
+    }
+    if cfg.kind == KinoKind::Attentive {
+        return crate::tal::train(cfg, train_set, val_set, prov, device, progress);
     }
     let started = Instant::now();
     let outputs = cfg.kind.network_outputs();
@@ -241,32 +283,8 @@ pub fn train(
     let mut files = Vec::new();
     for (m, net) in members.iter().enumerate() {
         let file = format!("{}.net{m}", prov.name);
-        let card = ModelCard {
-            name: file.clone(),
-            format: verti_nn::card::CARD_FORMAT,
-            summary: format!("network {m} of the kinodynamic model {}", prov.name),
-            input: Shape::Flat(INPUT_DIM),
-            layers: layers.clone(),
-            normalisation: format!("see {}.yaml", prov.name),
-            weights: WeightsInfo {
-                file: format!("{file}.bin"),
-                floats: 0,
-                fnv1a64: String::new(),
-            },
-            training: TrainingInfo {
-                data: prov.data.clone(),
-                command: prov.command.clone(),
-                seed: cfg.seed,
-                steps: cfg.steps as u64,
-                wall_time_s: wall,
-                verti_version: format!("verti {}", env!("CARGO_PKG_VERSION")),
-                settings: String::new(),
-            },
-            metrics: BTreeMap::new(),
-            constants: BTreeMap::new(),
-        };
-        let net = Network::from_params(card, &net.export_params()).map_err(|e| e.to_string())?;
-        networks.push(Arc::new(net));
+        let summary = format!("network {m} of the kinodynamic model {}", prov.name);
+        networks.push(export_network(net, &file, &summary, cfg, prov, wall)?);
         files.push(format!("{file}.yaml"));
     }
     let card = KinoCard {

@@ -61,7 +61,11 @@ pub fn learn_kino(
 ) -> Result<KinoTrained, String> {
     let train_data = load(&run.data, run.dt, "training")?;
     let val_data = load(&run.val, run.dt, "validation")?;
-    let (train_ex, val_ex) = (train_data.examples(), val_data.examples());
+    let kind = run.config.kind;
+    let (train_ex, val_ex) = (
+        train_data.examples_for(kind, run.config.seed),
+        val_data.examples_for(kind, run.config.seed),
+    );
     let prov = KinoProvenance {
         name: run.name.clone(),
         summary: run.summary.clone(),

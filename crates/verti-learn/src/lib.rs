@@ -15,6 +15,7 @@ pub mod kino_command;
 pub mod patches;
 pub mod seq;
 pub mod swae;
+pub mod tal;
 
 /// The device training runs on: burn's default device (the flex CPU backend here; with the
 /// `cuda` feature, `BURN_DEVICE=cuda` picks the GPU) with automatic differentiation.

@@ -224,6 +224,13 @@ impl Mlp {
         out_mean: &[f64],
         out_std: &[f64],
     ) -> Result<Mlp, String> {
+        self.fold_inputs(in_mean, in_std)?
+            .fold_outputs(out_mean, out_std)
+    }
+
+    /// The input half of [`Mlp::fold_standardisation`] (for networks whose outputs feed
+    /// another network, or whose last layer has an activation).
+    pub fn fold_inputs(&self, in_mean: &[f64], in_std: &[f64]) -> Result<Mlp, String> {
         let mut layers = self.layers.clone();
         let first = &mut layers[0];
         if in_mean.len() != first.inputs || in_std.len() != first.inputs {
@@ -238,6 +245,12 @@ impl Mlp {
             }
             first.bias[o] = b as f32;
         }
+        Ok(Mlp::from_layers(layers))
+    }
+
+    /// The output half of [`Mlp::fold_standardisation`].
+    pub fn fold_outputs(&self, out_mean: &[f64], out_std: &[f64]) -> Result<Mlp, String> {
+        let mut layers = self.layers.clone();
         let last = layers.last_mut().expect("an MLP has a layer");
         if out_mean.len() != last.outputs || out_std.len() != last.outputs {
             return Err(format!(
