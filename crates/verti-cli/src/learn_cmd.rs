@@ -12,7 +12,7 @@ pub enum LearnCommand {
     Swae(SwaeArgs),
     /// Train the local-patch terrain encoder (`patch-v1`) on crops from training worlds.
     Patch(PatchArgs),
-    /// Train a learned kinodynamic model (`mppi6`, `wmvct`, `tal`) on random-exploration data.
+    /// Train a learned kinodynamic model (`mppi6`, `wmvct`, `tal`) or TNT's traversability network (`tnt`) on random-exploration data.
     Kino(KinoArgs),
 }
 
@@ -20,8 +20,9 @@ pub enum LearnCommand {
 pub struct KinoArgs {
     /// Which model: mppi6 (an ensemble predicting the full 6-DoF change), wmvct (bicycle
     /// for x/y/yaw, terrain for z, a network for roll and pitch) or tal (an elevation map
-    /// encoded once per plan, gated by the vehicle's offset within it).
-    #[arg(long, value_parser = ["mppi6", "wmvct", "tal"])]
+    /// encoded once per plan, gated by the vehicle's offset within it); tnt trains TNT's
+    /// traversability network (its dynamics are tal's).
+    #[arg(long, value_parser = ["mppi6", "wmvct", "tal", "tnt"])]
     pub model: String,
     /// Training dataset (`verti data generate random --worlds verti-100-s1 ...`).
     #[arg(long, default_value = "data/random-s1")]

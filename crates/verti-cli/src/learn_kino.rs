@@ -7,9 +7,96 @@ use verti_kino::KinoKind;
 use verti_kino::features::OUTPUT_NAMES;
 use verti_learn::Device;
 use verti_learn::kino::KinoConfig;
-use verti_learn::kino_command::{KinoRun, learn_kino};
+use verti_learn::kino_command::{KinoRun, draw_curve, learn_kino};
+use verti_learn::trav::{TravRun, learn_trav};
+
+/// Progress of a training run: the bar, and plain lines every `eval_every` steps where
+/// stderr is not a terminal (logs of long runs).
+fn reporter<'a>(
+    pb: &'a indicatif::ProgressBar,
+    config: &'a KinoConfig,
+) -> impl FnMut(usize, usize, f64) + 'a {
+    let quiet = !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let started = std::time::Instant::now();
+    move |member: usize, step: usize, loss: f64| {
+        pb.set_position((member * config.steps + step) as u64);
+        if step.is_multiple_of(10) {
+            pb.set_message(format!("member {member} loss {loss:.4}"));
+        }
+        if quiet && (step.is_multiple_of(config.eval_every) || step == config.steps) {
+            eprintln!(
+                "member {member} step {step}/{}: loss {loss:.4} ({:.0} s)",
+                config.steps,
+                started.elapsed().as_secs_f64()
+            );
+        }
+    }
+}
+
+fn config_of(a: &KinoArgs, kind: KinoKind, members: usize) -> KinoConfig {
+    KinoConfig {
+        kind,
+        members: a.members.unwrap_or(members),
+        hidden: a.hidden.clone(),
+        steps: a.steps,
+        batch: a.batch,
+        lr: a.lr,
+        lr_final: a.lr_final,
+        seed: a.seed,
+        eval_every: a.eval_every,
+    }
+}
+
+/// `--model tnt`: TNT's traversability network (its dynamics are TAL's model, tal-v1).
+fn run_trav(a: &KinoArgs, command: &str, device: &Device) -> Result<(), String> {
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("models/tnt-v1.yaml"));
+    let name = out
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("tnt-v1")
+        .to_string();
+    let config = config_of(a, KinoKind::Ensemble, 1);
+    let run = TravRun {
+        config: config.clone(),
+        name,
+        out,
+        data: a.data.clone(),
+        val: a.val.clone(),
+        dt: a.dt,
+        command: command.into(),
+    };
+    let pb = bar(config.steps as u64, "training");
+    let t = learn_trav(&run, device, &mut reporter(&pb, &config))?;
+    pb.finish_and_clear();
+    println!(
+        "{}: {} training / {} validation patches; validation MSE {:.4} (predicting the \
+         training mean: {:.4}); {:.0} s",
+        t.network.card().name,
+        t.train_examples,
+        t.val_examples,
+        t.val_loss,
+        t.baseline_loss,
+        t.wall_time_s
+    );
+    let curve = run
+        .out
+        .with_file_name(format!("{}-curve.png", t.network.card().name));
+    draw_curve(&t.curve, &t.network.card().name, &curve)?;
+    println!(
+        "wrote {}, learning curve {}",
+        run.out.display(),
+        curve.display()
+    );
+    Ok(())
+}
 
 pub fn run(a: &KinoArgs, command: &str, device: &Device) -> Result<(), String> {
+    if a.model == "tnt" {
+        return run_trav(a, command, device);
+    }
     let (kind, members, summary) = match a.model.as_str() {
         "mppi6" => (
             KinoKind::Ensemble,
@@ -42,17 +129,7 @@ pub fn run(a: &KinoArgs, command: &str, device: &Device) -> Result<(), String> {
         .and_then(|s| s.to_str())
         .unwrap_or(&name)
         .to_string();
-    let config = KinoConfig {
-        kind,
-        members: a.members.unwrap_or(members),
-        hidden: a.hidden.clone(),
-        steps: a.steps,
-        batch: a.batch,
-        lr: a.lr,
-        lr_final: a.lr_final,
-        seed: a.seed,
-        eval_every: a.eval_every,
-    };
+    let config = config_of(a, kind, members);
     let run = KinoRun {
         geometry: crate::kino_cmd::geometry_of(&a.data)?,
         config: config.clone(),
@@ -65,23 +142,8 @@ pub fn run(a: &KinoArgs, command: &str, device: &Device) -> Result<(), String> {
         summary: summary.into(),
         command: command.into(),
     };
-    let total = (config.steps * config.members) as u64;
-    let pb = bar(total, "training");
-    let quiet = !std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let started = std::time::Instant::now();
-    let mut progress = |member: usize, step: usize, loss: f64| {
-        pb.set_position((member * config.steps + step) as u64);
-        if step.is_multiple_of(10) {
-            pb.set_message(format!("member {member} loss {loss:.4}"));
-        }
-        if quiet && (step.is_multiple_of(config.eval_every) || step == config.steps) {
-            eprintln!(
-                "member {member} step {step}/{}: loss {loss:.4} ({:.0} s)",
-                config.steps,
-                started.elapsed().as_secs_f64()
-            );
-        }
-    };
+    let pb = bar((config.steps * config.members) as u64, "training");
+    let mut progress = reporter(&pb, &config);
     let t = learn_kino(&run, device, &mut progress)?;
     pb.finish_and_clear();
     println!(

@@ -31,7 +31,7 @@ fn main() {
     .map(Arc::new)
     .collect();
     let spec = verti_sim::vehicles::builtin("hmmwv").unwrap();
-    for name in ["mppi", "wmvct", "mppi6", "tal"] {
+    for name in ["mppi", "wmvct", "mppi6", "tal", "tnt"] {
         let given = [
             ("samples".to_string(), ParamValue::Int(samples)),
             ("horizon".to_string(), ParamValue::Int(horizon)),

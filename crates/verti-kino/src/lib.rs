@@ -19,6 +19,7 @@ pub mod rollout;
 pub mod samples;
 pub mod shipped;
 pub mod systems;
+pub mod traversability;
 
 pub use card::{KinoCard, KinoFile, KinoKind};
 pub use features::{KinoState, Units};

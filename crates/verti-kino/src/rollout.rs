@@ -3,6 +3,7 @@
 
 use crate::features::{KinoState, OUTPUT_DIM, Units, heading_delta};
 use crate::model::{Geometry, KinoModel, StepScratch};
+use crate::traversability::{TravMap, Traversability};
 use std::collections::VecDeque;
 use verti_bench::observation::Pose6;
 use verti_bench::{Observation, TaskInfo};
@@ -139,6 +140,10 @@ impl Default for AttitudeWeights {
 pub struct AttitudeCost {
     path: PathCost,
     weights: AttitudeWeights,
+    /// TNT: a traversability network and its weight (per step, averaged over the horizon).
+    traversability: Option<(Traversability, f64)>,
+    map: Option<TravMap>,
+    units: Units,
 }
 
 impl AttitudeCost {
@@ -146,16 +151,31 @@ impl AttitudeCost {
         AttitudeCost {
             path: PathCost::new(weights.path.clone()),
             weights,
+            traversability: None,
+            map: None,
+            units: Units::new(1.0),
         }
+    }
+
+    /// The same cost plus `weight` × the predicted difficulty of the ground under every
+    /// rollout pose (TNT).
+    pub fn with_traversability(mut self, net: Traversability, weight: f64) -> AttitudeCost {
+        self.traversability = Some((net, weight));
+        self
     }
 }
 
 impl RolloutCost for AttitudeCost {
     fn reset(&mut self, task: &TaskInfo) {
         self.path.reset(task);
+        self.units = Units::new(task.world_scale);
+        self.map = None;
     }
     fn prepare(&mut self, obs: &Observation, ctx: &PlanContext) {
         self.path.prepare(obs, ctx);
+        if let Some((net, _)) = &self.traversability {
+            self.map = Some(net.plan_map(&obs.pose, &obs.world().terrain, self.units));
+        }
     }
     fn evaluate(
         &mut self,
@@ -167,9 +187,16 @@ impl RolloutCost for AttitudeCost {
         self.path.evaluate(ctx, controls, rollouts, costs);
         let w = &self.weights;
         let inv_h = 1.0 / controls.horizon as f64;
+        let trav = match (&self.traversability, &self.map) {
+            (Some((_, weight)), Some(map)) => Some((*weight * inv_h, map)),
+            _ => None,
+        };
         for (s, cost) in costs.iter_mut().enumerate() {
             let mut extra = 0.0;
             for p in rollouts.sample(s) {
+                if let Some((w, map)) = trav {
+                    extra += w * map.at(p);
+                }
                 for a in [p.roll.abs(), p.pitch.abs()] {
                     let over = (a - w.free).max(0.0);
                     extra += w.attitude * over * over * inv_h;

@@ -4,6 +4,7 @@
 use crate::attentive::{ATTENTIVE_INPUT_DIM, write_row};
 use crate::card::KinoKind;
 use crate::features::{INPUT_DIM, KinoState, OUTPUT_DIM, Units, heading_delta, write_inputs};
+use crate::traversability::{CHANNELS, FIELD, LABEL_HORIZON, labels, write_slopes};
 use crate::{KinoError, Result};
 use verti_core::Rng;
 
@@ -220,6 +221,33 @@ impl KinoData {
                     .delta_to_model(&heading_delta(&tr.poses[t], &tr.poses[t + 1]));
                 ex.inputs.extend_from_slice(&input);
                 ex.targets.extend(d.iter().map(|&v| v as f32));
+                ex.levels.push(tr.level);
+            }
+        }
+        ex
+    }
+
+    /// Traversability examples: the slope patch under every other pose (heading-aligned,
+    /// centred on the vehicle) and its labels over the next [`LABEL_HORIZON`]
+    /// (`crate::traversability::labels`); `dim` = the patch size, targets `traversability::OUTPUTS` wide.
+    pub fn traversability_examples(&self) -> Examples {
+        let patch = CHANNELS * FIELD * FIELD;
+        let mut ex = Examples {
+            dim: patch,
+            ..Default::default()
+        };
+        let steps = (LABEL_HORIZON / self.dt).round().max(1.0) as usize;
+        let mut input = vec![0.0f32; patch];
+        for tr in &self.trajectories {
+            let terrain = &self.worlds[tr.world].terrain;
+            for t in (0..tr.poses.len()).step_by(2) {
+                let Some(y) = labels(&tr.poses, &tr.commands, t, steps, self.dt_world, self.units)
+                else {
+                    continue;
+                };
+                write_slopes(&tr.poses[t], (0.0, 0.0), 1, terrain, self.units, &mut input);
+                ex.inputs.extend_from_slice(&input);
+                ex.targets.extend_from_slice(&y);
                 ex.levels.push(tr.level);
             }
         }

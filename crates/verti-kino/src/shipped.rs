@@ -3,6 +3,7 @@
 
 use crate::card::{KinoFile, parse_card};
 use crate::systems::LearnedSystem;
+use crate::traversability::Traversability;
 use std::path::Path;
 use std::sync::Arc;
 use verti_nn::Network;
@@ -86,6 +87,15 @@ pub fn all() -> Result<Vec<Arc<KinoFile>>, String> {
     SHIPPED.iter().map(load).collect()
 }
 
+/// The shipped traversability network of TNT (`verti learn kino --model tnt --steps 2000`).
+pub fn traversability() -> Result<Traversability, String> {
+    let n = net!("tnt-v1");
+    let p = Path::new(n.path);
+    let card = verti_nn::network::parse_card(n.card, p).map_err(|x| x.to_string())?;
+    let net = Network::from_bytes(card, n.weights, p).map_err(|x| x.to_string())?;
+    Traversability::new(Arc::new(net))
+}
+
 /// The learned planners whose models ship.
 pub fn systems() -> Vec<LearnedSystem> {
     vec![
@@ -108,5 +118,12 @@ pub fn systems() -> Vec<LearnedSystem> {
              obstacles and predicted roll/pitch",
             || model("tal-v1"),
         ),
+        LearnedSystem::new(
+            "tnt",
+            "TNT: TAL's planner and model (tal-v1) plus a learned traversability cost (tnt-v1: \
+             a convolutional network over terrain slopes predicting tilt and lost progress)",
+            || model("tal-v1"),
+        )
+        .with_traversability(traversability),
     ]
 }

@@ -4,6 +4,7 @@
 use crate::card::KinoFile;
 use crate::model::KinoModel;
 use crate::rollout::{AttitudeCost, AttitudeWeights, LearnedRollout};
+use crate::traversability::Traversability;
 use std::path::Path;
 use std::sync::{Arc, OnceLock};
 use verti_bench::{MobilitySystem, SystemInfo, SystemRegistry};
@@ -16,12 +17,17 @@ use verti_systems::rollout::PathCostWeights;
 /// Where a system's default model comes from (the shipped weights, loaded once).
 pub type ModelSource = fn() -> Result<Arc<KinoFile>, String>;
 
-/// A learned planner: a name, a summary and its default model.
+/// Where a system's default traversability network comes from.
+pub type TravSource = fn() -> Result<Traversability, String>;
+
+/// A learned planner: a name, a summary, its default model, and (TNT) a traversability
+/// network whose value is a rollout cost.
 pub struct LearnedSystem {
     pub name: &'static str,
     pub summary: &'static str,
     pub default_model: ModelSource,
     loaded: OnceLock<Result<Arc<KinoFile>, String>>,
+    traversability: Option<(TravSource, OnceLock<Result<Traversability, String>>)>,
 }
 
 impl LearnedSystem {
@@ -31,13 +37,24 @@ impl LearnedSystem {
             summary,
             default_model,
             loaded: OnceLock::new(),
+            traversability: None,
         }
+    }
+
+    /// Adds the traversability cost (parameters `w_trav` and `trav_model`).
+    pub fn with_traversability(mut self, source: TravSource) -> Self {
+        self.traversability = Some((source, OnceLock::new()));
+        self
     }
 }
 
+/// Default weight of the traversability cost: a predicted difficulty of 1 (30°-class tilt or
+/// no progress) on every step costs what 50 m² of squared goal distance does.
+const W_TRAV: f64 = 50.0;
+
 /// MPPI defaults for learned models: the reference's 800 samples x 20 steps; one step is one
 /// model step (0.2 s for the shipped models), so the horizon spans 4 s.
-fn params() -> Vec<ParamSpec> {
+fn params(traversability: bool) -> Vec<ParamSpec> {
     let w = AttitudeWeights::default();
     let mut specs: Vec<ParamSpec> = mppi_params()
         .into_iter()
@@ -91,8 +108,24 @@ fn params() -> Vec<ParamSpec> {
             "",
             "model card (YAML) to use instead of the shipped one",
         ),
-        rate,
     ]);
+    if traversability {
+        specs.extend([
+            ParamSpec::float(
+                "w_trav",
+                W_TRAV,
+                0.0,
+                1e6,
+                "weight of the predicted traversal difficulty under each rollout pose",
+            ),
+            ParamSpec::path(
+                "trav_model",
+                "",
+                "traversability network card (YAML) to use instead of the shipped one",
+            ),
+        ]);
+    }
+    specs.push(rate);
     specs
 }
 
@@ -101,7 +134,7 @@ impl Factory<dyn MobilitySystem> for LearnedSystem {
         SystemInfo {
             name: self.name.into(),
             summary: self.summary.into(),
-            params: params(),
+            params: params(self.traversability.is_some()),
         }
     }
 
@@ -133,11 +166,19 @@ impl Factory<dyn MobilitySystem> for LearnedSystem {
             ..AttitudeWeights::default()
         };
         let model = LearnedRollout::new(KinoModel::new(file));
+        let mut cost = AttitudeCost::new(weights);
+        if let Some((source, loaded)) = &self.traversability {
+            let net = match p.path("trav_model") {
+                Some(path) if path != Path::new("") => Traversability::load(path)?,
+                _ => loaded.get_or_init(source).clone()?,
+            };
+            cost = cost.with_traversability(net, p.float("w_trav"));
+        }
         Ok(Box::new(Mppi::with_model(
             self.name,
             mppi,
             Box::new(model),
-            Box::new(AttitudeCost::new(weights)),
+            Box::new(cost),
         )))
     }
 }

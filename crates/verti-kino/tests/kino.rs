@@ -154,7 +154,7 @@ fn learned_planners_act_the_same_twice() {
     let info = task_info(&w, &spec, 1, &Default::default()).unwrap();
     let obs = test_observation(&w, info.start, 0.0, info.goal, &info.global_path);
     let given = [("samples".to_string(), ParamValue::Int(64))];
-    for name in ["wmvct", "mppi6", "tal"] {
+    for name in ["wmvct", "mppi6", "tal", "tnt"] {
         let act = || {
             let mut s = registry.create(name, &given).unwrap();
             s.reset(&info);

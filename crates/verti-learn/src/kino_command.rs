@@ -117,7 +117,7 @@ pub fn learn_kino(
     file.card.training.wall_time_s = (report.wall_time_s * 10.0).round() / 10.0;
     file.save(&run.out).map_err(|e| e.to_string())?;
     let curve_png = run.out.with_file_name(format!("{}-curve.png", run.name));
-    draw_curve(&report, &run.name, &curve_png)?;
+    draw_curve(&report.curve, &run.name, &curve_png)?;
     Ok(KinoTrained {
         file,
         report,
@@ -128,13 +128,17 @@ pub fn learn_kino(
     })
 }
 
-fn draw_curve(report: &KinoReport, name: &str, out: &Path) -> Result<(), String> {
-    let members = report.curve.iter().map(|p| p.member).max().unwrap_or(0) + 1;
+/// The learning curve (log10 MSE per member, training and validation) as a PNG.
+pub fn draw_curve(
+    curve: &[crate::kino::KinoCurvePoint],
+    name: &str,
+    out: &Path,
+) -> Result<(), String> {
+    let members = curve.iter().map(|p| p.member).max().unwrap_or(0) + 1;
     let mut series = Vec::new();
     for m in 0..members {
         let pts = |f: fn(&crate::kino::KinoCurvePoint) -> f64| {
-            report
-                .curve
+            curve
                 .iter()
                 .filter(|p| p.member == m)
                 .map(|p| [p.step as f64, f(p).max(1e-9).log10()])
