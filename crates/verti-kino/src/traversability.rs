@@ -302,6 +302,6 @@ mod tests {
         assert_eq!(labels(&stuck, &cmd, 0, 5, dt, units).unwrap(), [0.0, 1.0]);
         // too close to the end, or too slow a command to judge
         assert!(labels(&moving, &cmd, 3, 5, dt, units).is_none());
-        assert!(labels(&moving, &vec![(0.1, 0.0); 8], 0, 5, dt, units).is_none());
+        assert!(labels(&moving, &[(0.1, 0.0); 8], 0, 5, dt, units).is_none());
     }
 }
