@@ -156,7 +156,7 @@ def test_sim_rejects_bad_input(world):
 def test_vehicles_and_systems():
     assert "hmmwv" in verti.vehicles()
     names = [s["name"] for s in verti.systems()]
-    assert names == ["pid", "eh", "mppi", "oracle"]
+    assert names == ["pid", "eh", "mppi", "oracle", "mppi6", "wmvct", "tal", "tnt"]
     pid = verti.systems()[0]
     speed = next(p for p in pid["params"] if p["name"] == "speed")
     assert speed["type"] == "float" and speed["default"] == 3.0 and speed["max"] == 30.0
@@ -192,6 +192,13 @@ def test_evaluate_returns_trials_and_a_table(world):
     table = verti.results_table(results)
     assert table["task"] == [1, 2] and table["roll_abs_mean"][0] == r["roll"]["abs"]["mean"]
     assert len({len(c) for c in table.values()}) == 1
+
+
+def test_learned_planners_run_from_python(world):
+    # the shipped models load without training; small plans keep the test quick
+    for name in ["tal", "tnt"]:
+        r = verti.evaluate(name, [world], tasks=[1], jobs=1, max_time=2.0, params={"samples": 32})
+        assert r[0]["system"] == name and r[0]["path_length"] > 0.5
 
 
 def test_evaluate_writes_a_resumable_results_folder(world, tmp_path):

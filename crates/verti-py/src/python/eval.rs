@@ -99,6 +99,9 @@ pub(super) fn results_to_py(py: Python<'_>, results: &[TrialResult]) -> PyResult
 pub(super) fn system_registry() -> verti_bench::SystemRegistry {
     let mut r = verti_bench::SystemRegistry::new();
     verti_systems::register(&mut r);
+    // the hybrids whose trained models ship (mppi6, wmvct, tal, tnt): no burn involved
+    verti_kino::systems::register(&mut r, verti_kino::shipped::systems())
+        .expect("the shipped learned systems have distinct names and valid parameters");
     r
 }
 
