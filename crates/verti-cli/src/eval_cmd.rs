@@ -89,16 +89,66 @@ pub struct EvalArgs {
     log_steps: Option<String>,
 }
 
+/// The systems `--system` names: one name, a comma-separated list, or `all` (every registered
+/// system except the privileged `oracle`, which reads the simulator and is an upper bound, not
+/// a contestant).
+fn system_names(spec: &str, registry: &verti_bench::SystemRegistry) -> Result<Vec<String>, String> {
+    let names: Vec<String> = if spec == "all" {
+        registry
+            .list()
+            .map(|i| i.name.clone())
+            .filter(|n| n != "oracle")
+            .collect()
+    } else {
+        spec.split(',').map(|s| s.trim().to_string()).collect()
+    };
+    if names.iter().any(|n| n.is_empty()) {
+        return Err(format!("--system `{spec}`: an empty system name"));
+    }
+    Ok(names)
+}
+
 pub fn eval(a: EvalArgs) -> CmdResult {
     let registry = crate::registries::systems();
-    let given = a
-        .params
-        .iter()
-        .map(|p| registry.parse_param(&a.system, p))
-        .collect::<Result<Vec<_>, _>>()?;
-    let params = registry.resolve(&a.system, &given)?;
-    // build one up front so that a system that cannot be built fails before any work
-    registry.build(&a.system, &params)?;
+    let systems = system_names(&a.system, &registry)?;
+    let several = systems.len() > 1;
+    // every system's parameters, resolved and built once before any work: a typo fails now
+    let mut resolved = Vec::new();
+    for system in &systems {
+        let info = registry.info(system)?;
+        let given = a
+            .params
+            .iter()
+            // with several systems, a parameter goes to those that declare it
+            .filter(|p| {
+                !several || {
+                    let name = p.split('=').next().unwrap_or("");
+                    info.params.iter().any(|s| s.name == name)
+                }
+            })
+            .map(|p| registry.parse_param(system, p))
+            .collect::<Result<Vec<_>, _>>()?;
+        let params = registry.resolve(system, &given)?;
+        registry.build(system, &params)?;
+        resolved.push(params);
+    }
+    if several {
+        for p in &a.params {
+            let name = p.split('=').next().unwrap_or("");
+            let known = systems.iter().any(|s| {
+                registry
+                    .info(s)
+                    .is_ok_and(|i| i.params.iter().any(|x| x.name == name))
+            });
+            if !known {
+                return Err(format!(
+                    "--param {p}: none of {} has a parameter `{name}`",
+                    systems.join(", ")
+                )
+                .into());
+            }
+        }
+    }
     let selection = parse_tasks(&a.tasks)?;
     let (set, scale) = load_set_checked(&a.worlds, &a.scale)?;
     let vehicle_name = a
@@ -109,10 +159,61 @@ pub fn eval(a: EvalArgs) -> CmdResult {
     if let Some(w) = verti_bench::identity::scale_mismatch(&vehicle, scale) {
         eprintln!("warning: {w}");
     }
+    let set_name = set.name.clone();
     let worlds: Vec<Arc<World>> = set.worlds.into_iter().map(Arc::new).collect();
-    let out = a
-        .out
-        .unwrap_or_else(|| PathBuf::from("results").join(format!("{}-{}", a.system, set.name)));
+    let per_system = verti_bench::eval::select_tasks(&worlds, &selection)?.len();
+    // one progress display for the whole sequence
+    let pb = bar((per_system * systems.len()) as u64, &systems.join(", "));
+    for (system, params) in systems.iter().zip(resolved) {
+        let out = match (&a.out, several) {
+            (Some(dir), false) => dir.clone(),
+            (Some(dir), true) => dir.join(system),
+            (None, _) => PathBuf::from("results").join(format!("{system}-{set_name}")),
+        };
+        pb.set_message(system.clone());
+        let shared = Shared {
+            registry: &registry,
+            worlds: &worlds,
+            vehicle: &vehicle,
+            scale,
+            set_name: &set_name,
+            pb: &pb,
+        };
+        let lines = eval_system(&a, system, params, &shared, &out)?;
+        for line in lines {
+            // above the bar where there is one; plain stdout otherwise (logs, pipes)
+            if pb.is_hidden() {
+                println!("{line}");
+            } else {
+                pb.println(line);
+            }
+        }
+    }
+    pb.finish_and_clear();
+    Ok(())
+}
+
+/// What every system of one `verti eval` shares.
+struct Shared<'a> {
+    registry: &'a verti_bench::SystemRegistry,
+    worlds: &'a [Arc<World>],
+    vehicle: &'a verti_sim::VehicleSpec,
+    scale: f64,
+    set_name: &'a str,
+    pb: &'a indicatif::ProgressBar,
+}
+
+/// One system's evaluation; returns its summary lines.
+fn eval_system(
+    a: &EvalArgs,
+    system: &str,
+    params: verti_core::params::Params,
+    sh: &Shared,
+    out: &std::path::Path,
+) -> Result<Vec<String>, verti_bench::eval::EvalError> {
+    let (registry, worlds, vehicle, scale, pb) =
+        (sh.registry, sh.worlds, sh.vehicle, sh.scale, sh.pb);
+    let selection = parse_tasks(&a.tasks)?;
     let jobs = a.jobs.unwrap_or_else(rayon::current_num_threads);
     let episode = EpisodeConfig {
         rules: a.rules,
@@ -121,17 +222,22 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         start: a.start,
         ..Default::default()
     };
-    let warn = |m: &str| eprintln!("warning: {m}");
+    let warn = |m: &str| pb.println(format!("warning: {m}"));
+    let steps_dir = out.join(verti_bench::eval::STEPS_DIR);
+    let write_log = |r: &verti_bench::TrialResult, log: &EpisodeLog| {
+        let path = steps_dir.join(verti_log::log_file_name(r.task));
+        verti_log::write_steps(&path, r, &log.steps).map_err(|e| e.to_string())
+    };
     let setup = EvalSetup {
-        worlds: &worlds,
-        vehicle: &vehicle,
+        worlds,
+        vehicle,
         episode,
         jobs,
-        out: out.clone(),
+        out: out.to_path_buf(),
         resume: a.resume,
         force: a.force,
         run: RunInfo {
-            system: a.system.clone(),
+            system: system.to_string(),
             params: params.clone(),
             vehicle: vehicle.name.clone(),
             worlds: a.worlds.clone(),
@@ -140,16 +246,6 @@ pub fn eval(a: EvalArgs) -> CmdResult {
             seed: a.seed,
             max_time: a.max_time,
         },
-        step_log: None,
-        cancel: None,
-        warn: Some(&warn),
-    };
-    let steps_dir = out.join(verti_bench::eval::STEPS_DIR);
-    let write_log = |r: &verti_bench::TrialResult, log: &EpisodeLog| {
-        let path = steps_dir.join(verti_log::log_file_name(r.task));
-        verti_log::write_steps(&path, r, &log.steps).map_err(|e| e.to_string())
-    };
-    let setup = EvalSetup {
         // `evaluate` creates the directory (and empties it on a fresh start)
         step_log: a
             .log_steps
@@ -158,25 +254,23 @@ pub fn eval(a: EvalArgs) -> CmdResult {
                 seconds: if kind == "all" { f64::INFINITY } else { 10.0 },
                 write: &write_log,
             }),
-        ..setup
+        cancel: None,
+        warn: Some(&warn),
     };
-    let total = verti_bench::eval::select_tasks(&worlds, &selection)?.len();
-    let pb = bar(total as u64, &a.system);
     let make = || {
         registry
-            .build(&a.system, &params)
+            .build(system, &params)
             .expect("the system was built once already")
     };
     let t0 = std::time::Instant::now();
     let results = evaluate(&setup, &selection, &make, &|_| pb.inc(1))?;
-    pb.finish_and_clear();
     let wall = t0.elapsed().as_secs_f64();
     let count = |o: Outcome| results.iter().filter(|r| r.outcome == o).count();
     let n = results.len().max(1) as f64;
-    println!(
+    let mut lines = vec![format!(
         "{} on {} with {} ({} tasks, {} jobs, {:.1} s): success {:.1}%  rollover {:.1}%  stuck {:.1}%  timeout {:.1}%  error {:.1}%",
-        a.system,
-        set.name,
+        system,
+        sh.set_name,
         vehicle.name,
         results.len(),
         jobs,
@@ -186,27 +280,27 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         100.0 * count(Outcome::Stuck) as f64 / n,
         100.0 * count(Outcome::Timeout) as f64 / n,
         100.0 * count(Outcome::Error) as f64 / n,
-    );
+    )];
     let sim_seconds: f64 = results.iter().map(|r| r.time).sum();
-    println!(
+    lines.push(format!(
         "simulated {:.0} s in {:.1} s of wall time; results in {}",
         sim_seconds,
         wall,
         out.join("results.jsonl").display()
-    );
+    ));
     for r in results
         .iter()
         .filter(|r| r.outcome == Outcome::Error)
         .take(5)
     {
-        println!(
+        lines.push(format!(
             "  task {} ({}): {}",
             r.task,
             r.world_name,
             r.error.as_deref().unwrap_or("?")
-        );
+        ));
     }
-    Ok(())
+    Ok(lines)
 }
 
 #[derive(Args)]

@@ -404,3 +404,47 @@ fn outputs_must_be_png_files_in_existing_directories() {
     run_ok(&["world", "render", "verti-1:1", "--out", &d("w.PNG")]);
     assert!(dir.join("w.PNG").is_file());
 }
+
+#[test]
+fn several_systems_evaluate_in_sequence_into_their_own_folders() {
+    let out = tmp("several");
+    let out_s = out.to_str().unwrap();
+    let stdout = run_ok(&[
+        "eval",
+        "--system",
+        "pid,tal",
+        "--worlds",
+        "verti-1",
+        "--tasks",
+        "1-2",
+        "--max-time",
+        "2",
+        "--param",
+        "samples=16",
+        "--out",
+        out_s,
+    ]);
+    // `samples` is tal's parameter only; pid ran with its own defaults
+    for system in ["pid", "tal"] {
+        let rs = lines(&out.join(system).join("results.jsonl"));
+        assert_eq!(rs.len(), 2, "{system}");
+        assert!(rs.iter().all(|r| r["system"] == system));
+        assert!(stdout.contains(&format!("{system} on verti-1")), "{stdout}");
+    }
+    let e = run_err(&[
+        "eval",
+        "--system",
+        "pid,eh",
+        "--param",
+        "samples=16",
+        "--tasks",
+        "1",
+    ]);
+    assert!(
+        e.contains("none of pid, eh has a parameter `samples`"),
+        "{e}"
+    );
+    let e = run_err(&["eval", "--system", "pid,nobody", "--tasks", "1"]);
+    assert!(e.contains("nobody"), "{e}");
+    let _ = std::fs::remove_dir_all(&out);
+}
