@@ -197,11 +197,22 @@ mod with_burn {
 
     pub fn run(cmd: LearnCommand) -> Result<(), String> {
         let device = verti_learn::training_device();
-        if let LearnCommand::Kino(a) = &cmd {
-            return crate::learn_kino::run(a, &command_line(), &device);
+        match cmd {
+            LearnCommand::Kino(a) => crate::learn_kino::run(&a, &command_line(), &device),
+            LearnCommand::Swae(a) => run_autoencoder(Autoencoder::Swae(a), &device),
+            LearnCommand::Patch(a) => run_autoencoder(Autoencoder::Patch(a), &device),
         }
+    }
+
+    /// The two trainings that share the SWAE code.
+    enum Autoencoder {
+        Swae(SwaeArgs),
+        Patch(PatchArgs),
+    }
+
+    fn run_autoencoder(cmd: Autoencoder, device: &verti_learn::Device) -> Result<(), String> {
         let (run, data) = match &cmd {
-            LearnCommand::Swae(a) => (
+            Autoencoder::Swae(a) => (
                 config(
                     &a.train,
                     128,
@@ -221,8 +232,7 @@ mod with_burn {
                 ),
                 &a.out,
             ),
-            LearnCommand::Kino(_) => unreachable!("handled above"),
-            LearnCommand::Patch(a) => (
+            Autoencoder::Patch(a) => (
                 config(
                     &a.train,
                     64,
@@ -267,10 +277,10 @@ mod with_burn {
             }
         };
         let trained = match cmd {
-            LearnCommand::Swae(a) => {
-                learn_swae(&settings, &a.data, a.val_fraction, &device, &mut progress)?
+            Autoencoder::Swae(a) => {
+                learn_swae(&settings, &a.data, a.val_fraction, device, &mut progress)?
             }
-            LearnCommand::Patch(a) => learn_patch(
+            Autoencoder::Patch(a) => learn_patch(
                 &settings,
                 &PatchSettings {
                     train_worlds: a.worlds,
@@ -279,10 +289,9 @@ mod with_burn {
                     height_scale: a.height_scale,
                     seed: a.train.seed,
                 },
-                &device,
+                device,
                 &mut progress,
             )?,
-            LearnCommand::Kino(_) => unreachable!("handled above"),
         };
         pb.finish_and_clear();
         report(&trained);
