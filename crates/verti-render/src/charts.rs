@@ -94,6 +94,36 @@ pub fn series_color(i: usize) -> Rgb<u8> {
     SERIES_COLORS[i % SERIES_COLORS.len()]
 }
 
+/// Colours of the benchmark's systems, one hue per family so that ten bars side by side stay
+/// legible: classical planners blue (pid, eh, mppi), RL greens (rl, mcl, acl), learned-model
+/// hybrids oranges (wmvct, mppi6, tal, tnt), the privileged oracle grey. A series named
+/// `system` or `system-…`/`system …` (a run label) gets its system's colour.
+pub fn system_color(name: &str) -> Option<Rgb<u8>> {
+    let system = name.split(['-', ' ', '@']).next()?;
+    Some(match system {
+        "pid" => Rgb([0x9E, 0xCA, 0xE1]),
+        "eh" => Rgb([0x42, 0x92, 0xC6]),
+        "mppi" => Rgb([0x08, 0x45, 0x94]),
+        "rl" => Rgb([0xA1, 0xD9, 0x9B]),
+        "mcl" => Rgb([0x41, 0xAB, 0x5D]),
+        "acl" => Rgb([0x00, 0x6D, 0x2C]),
+        "wmvct" => Rgb([0xFD, 0xD0, 0xA2]),
+        "mppi6" => Rgb([0xFD, 0x8D, 0x3C]),
+        "tal" => Rgb([0xD9, 0x48, 0x01]),
+        "tnt" => Rgb([0x8C, 0x2D, 0x04]),
+        "oracle" => Rgb([0x73, 0x73, 0x73]),
+        _ => return None,
+    })
+}
+
+/// Colour of the `i`-th distinct series name: its system's, else the `i`-th series colour.
+fn name_color(names: &[&str], i: usize) -> Rgb<u8> {
+    names
+        .get(i)
+        .and_then(|n| system_color(n))
+        .unwrap_or_else(|| series_color(i))
+}
+
 /// Distinct series names over all panels, in first-seen order (the legend, and the index of
 /// each name's colour).
 fn series_names(panels: &[Panel]) -> Vec<&str> {
@@ -384,7 +414,10 @@ fn draw_panel(
             Anchor::CENTER,
         )?;
         for (s, series) in panel.series.iter().enumerate() {
-            let color = series_color(names.iter().position(|n| *n == series.name).unwrap_or(s));
+            let color = name_color(
+                names,
+                names.iter().position(|n| *n == series.name).unwrap_or(s),
+            );
             let (x0, x1) = bar_span(&b, ng, ns, g, s);
             let v = series.values.get(g).copied().unwrap_or(f64::NAN);
             if v.is_nan() {
@@ -459,7 +492,7 @@ pub fn grouped_bars_image(panels: &[Panel], columns: usize) -> Result<RgbImage, 
             (cy - s).round(),
             x + LEGEND_SWATCH,
             (cy + s).round(),
-            series_color(i),
+            name_color(&names, i),
             1.0,
         );
         text(
@@ -485,6 +518,30 @@ pub fn grouped_bars_png(panels: &[Panel], columns: usize, out: &Path) -> Result<
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn the_ten_systems_have_distinct_colours_by_family() {
+        let ten = [
+            "pid", "eh", "mppi", "rl", "mcl", "acl", "wmvct", "mppi6", "tal", "tnt",
+        ];
+        let colours: Vec<_> = ten.iter().map(|n| system_color(n).unwrap()).collect();
+        for (i, a) in colours.iter().enumerate() {
+            assert!(
+                colours[i + 1..].iter().all(|b| b != a),
+                "{} repeats",
+                ten[i]
+            );
+        }
+        // a run label keeps its system's colour; other names fall back to the series colours
+        assert_eq!(system_color("tal-verti-100"), system_color("tal"));
+        assert_eq!(system_color("mine"), None);
+        assert_eq!(name_color(&["mine", "tnt"], 0), series_color(0));
+        assert_eq!(
+            name_color(&["mine", "tnt"], 1),
+            system_color("tnt").unwrap()
+        );
+    }
+
     use super::*;
 
     fn series(name: &str, values: &[f64]) -> Series {
