@@ -510,10 +510,24 @@ pub fn report(a: ReportArgs) -> CmdResult {
         ),
     )?;
     write("summary.json", &serde_json::to_string_pretty(&summary)?)?;
+    let mut pages = 0;
+    if summary.systems.len() > 1 {
+        for (i, s) in summary.systems.iter().enumerate() {
+            if let Some(page) = verti_bench::report::system_page(&summary, i) {
+                write(&verti_bench::report::system_page_name(&s.name), &page)?;
+                pages += 1;
+            }
+        }
+    }
     println!("{md}");
     println!(
-        "report written to {} (report.md, report.html, summary.json, fig6.png)",
-        a.out.display()
+        "report written to {} (report.md, report.html{}, summary.json, fig6.png)",
+        a.out.display(),
+        if pages > 0 {
+            format!(" with {pages} per-system pages")
+        } else {
+            String::new()
+        }
     );
     Ok(())
 }

@@ -56,7 +56,7 @@ mod writers;
 pub use aggregate::summarize;
 pub use charts::{ChartPanel, ChartSeries, Fig6Metric, fig6_charts};
 pub use load::{Loaded, LoadedFile, ReportError, load_results, load_results_from};
-pub use writers::{html, markdown};
+pub use writers::{html, markdown, system_page, system_page_name};
 
 use crate::episode::TrialResult;
 use crate::metrics::Stats;

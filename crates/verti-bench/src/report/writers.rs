@@ -98,18 +98,81 @@ tbody tr:hover{background:#f6f8fa}.note{color:#555;font-size:.9em}\
 figure{margin:1em 0}figure img{max-width:100%;border:1px solid #eee}\
 figcaption{color:#444;font-size:.9em;margin-top:.3em}";
 
+/// The file name of a system's own page in the HTML report (`system-<name>.html`, with
+/// anything but letters, digits, `-` and `_` replaced by `_`).
+pub fn system_page_name(name: &str) -> String {
+    let slug: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("system-{slug}.html")
+}
+
+/// One system's page: its outcomes, its Fig. 6 rows and other metrics, on their own (the
+/// side-by-side tables get hard to read with ten systems), linked back to the report.
+pub fn system_page(summary: &Summary, index: usize) -> Option<String> {
+    let one = summary.systems.get(index)?;
+    let alone = Summary {
+        trials: one.outcomes.trials,
+        systems: vec![one.clone()],
+    };
+    let mut out = html_with(
+        &alone,
+        &[],
+        &format!("{} ({})", one.name, one.vehicle),
+        false,
+    );
+    let back = "<p><a href=\"report.html\">← all systems</a></p>\n</body>";
+    out = out.replacen("</body>", back, 1);
+    Some(out)
+}
+
 /// The summary as a self-contained HTML page (inline CSS, no scripts) with the given figures
-/// embedded by relative path: `(title, png file name)`, e.g. `("Fig. 6", "fig6.png")`.
+/// embedded by relative path: `(title, png file name)`, e.g. `("Fig. 6", "fig6.png")`. With
+/// several systems it links each one's page ([`system_page`]).
 pub fn html(summary: &Summary, figures: &[(&str, &str)]) -> String {
+    html_with(
+        summary,
+        figures,
+        "Evaluation report",
+        summary.systems.len() > 1,
+    )
+}
+
+fn html_with(summary: &Summary, figures: &[(&str, &str)], heading: &str, links: bool) -> String {
     let mut out = String::new();
     let _ = write!(
         out,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
-         <title>verti evaluation report</title>\n<style>{CSS}</style>\n</head>\n<body>\n\
-         <h1>Evaluation report</h1>\n<p>{} trials, {} system(s).</p>\n",
+         <title>verti: {}</title>\n<style>{CSS}</style>\n</head>\n<body>\n\
+         <h1>{}</h1>\n<p>{} trials, {} system(s).</p>\n",
+        esc(heading),
+        esc(heading),
         summary.trials,
         summary.systems.len()
     );
+    if links {
+        out.push_str("<p>Per system: ");
+        let items: Vec<String> = summary
+            .systems
+            .iter()
+            .map(|s| {
+                format!(
+                    "<a href=\"{}\">{}</a>",
+                    esc(&system_page_name(&s.name)),
+                    esc(&s.name)
+                )
+            })
+            .collect();
+        out.push_str(&items.join(" · "));
+        out.push_str("</p>\n");
+    }
     if summary.systems.is_empty() {
         out.push_str("<p>No results.</p>\n");
     } else {
@@ -161,5 +224,20 @@ mod tests {
         assert!(h.contains("&lt;x|y&gt;") && !h.contains("<x|y>"));
         assert!(h.contains("<img src=\"fig6.png\" alt=\"Fig. 6 &lt;all&gt;\">"));
         assert!(markdown(&summarize(&odd)).contains("<x\\|y>"));
+        // one page per system, linked from the report
+        let page = system_page_name("<x|y>");
+        assert_eq!(page, "system-_x_y_.html");
+        assert!(
+            h.contains(&format!("<a href=\"{page}\">&lt;x|y&gt;</a>")),
+            "{h}"
+        );
+        let own = system_page(&summarize(&odd), 0).unwrap();
+        assert!(own.contains("&lt;x|y&gt;") && own.contains("report.html"));
+        // only its own column
+        assert!(
+            h.contains("<th>B</th>") && !own.contains("<th>B</th>"),
+            "{own}"
+        );
+        assert!(system_page(&summarize(&odd), 9).is_none());
     }
 }
