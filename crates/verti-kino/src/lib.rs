@@ -3,10 +3,13 @@
 //! planning and evaluation need is here, in plain Rust.
 //!
 //! * [`features`]: what a model sees and predicts, one code path for training and planning;
+//! * [`attentive`]: TAL's map encoder, offset gate and dynamics inputs;
+//! * [`traversability`]: TNT's learned traversability map and its labels;
 //! * [`card`]: the model file (a YAML card plus verti-nn networks);
 //! * [`model`]: one model step in world units, and the kinematic bicycle baseline;
 //! * [`rollout`]: a model inside MPPI ([`rollout::LearnedRollout`]) and the attitude-aware cost;
-//! * [`systems`]: the registered planners (`mppi6`, `wmvct`, ...).
+//! * [`systems`]: the registered planners (`mppi6`, `wmvct`, `tal`, `tnt`);
+//! * [`shipped`]: the trained models compiled in.
 
 use std::path::PathBuf;
 
