@@ -48,9 +48,10 @@ impl LearnedSystem {
     }
 }
 
-/// Default weight of the traversability cost: a predicted difficulty of 1 (30°-class tilt or
-/// no progress) on every step costs what 50 m² of squared goal distance does.
-const W_TRAV: f64 = 50.0;
+/// Default weight of the traversability cost, chosen on 20 tasks of verti-100-s2 (never the
+/// evaluation set): success 65 % at 10, 45 % at 50, 10 % at 200 (TAL alone: 65 %); heavier
+/// weights make the planner too timid to finish.
+const W_TRAV: f64 = 10.0;
 
 /// MPPI defaults for learned models: the reference's 800 samples x 20 steps; one step is one
 /// model step (0.2 s for the shipped models), so the horizon spans 4 s.
