@@ -274,6 +274,16 @@ fn fold_attentive(
 
 /// Parses a card's YAML, naming the file in errors.
 pub fn parse_card(text: &str, path: &Path) -> Result<KinoCard> {
+    // a common slip: one of the model's network cards instead of the model card
+    if text.lines().any(|l| l.starts_with("layers:")) && !text.contains("\nnetworks:") {
+        return Err(KinoError::Card {
+            path: path.to_path_buf(),
+            field: "card".into(),
+            why: "this is a network card (one of a model's networks); pass the model's own card \
+                  (e.g. models/mppi6-v1.yaml), which lists its networks"
+                .into(),
+        });
+    }
     serde_norway::from_str(text).map_err(|e| KinoError::Card {
         path: path.to_path_buf(),
         field: e

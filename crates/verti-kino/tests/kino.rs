@@ -85,6 +85,11 @@ fn a_card_naming_a_missing_network_is_refused_by_field() {
     let file = shipped::model("wmvct-v1").unwrap();
     let path = dir.join("m.yaml");
     file.save(&path).unwrap();
+    // a network card given where the model card belongs is named for what it is
+    let err = KinoFile::load(&dir.join(&file.card.networks[0]))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("this is a network card"), "{err}");
     std::fs::remove_file(dir.join(&file.card.networks[0])).unwrap();
     let err = KinoFile::load(&path).unwrap_err().to_string();
     assert!(err.contains("m.yaml") && err.contains("networks"), "{err}");
