@@ -165,6 +165,20 @@ def test_vehicles_and_systems():
     assert samples["type"] == "int" and samples["default"] == 800
 
 
+def test_worlds_generate_from_any_elevation_source():
+    rock = verti.World.generate(seed=0, index=3, count=10)
+    same = verti.World.generate(seed=0, index=3, count=10, elevation="procedural-rock")
+    assert np.array_equal(rock.heights, same.heights)
+    swae = verti.World.generate(seed=0, index=3, count=10, elevation="swae-v1",
+                                elevation_params={"latent_scale": 0.5})
+    assert swae.level == rock.level and not np.array_equal(swae.heights, rock.heights)
+    assert len(verti.World.generate_set(seed=0, count=2, elevation="swae-v1")) == 2
+    with pytest.raises(ValueError, match="nothing"):
+        verti.World.generate(elevation="nothing")
+    with pytest.raises(ValueError, match="latent_scale"):
+        verti.World.generate(elevation="swae-v1", elevation_params={"latent_scale": 9.0})
+
+
 def test_world_errors_have_rust_messages(tmp_path):
     with pytest.raises(FileNotFoundError, match="missing: No such file"):
         verti.World.load(str(tmp_path / "missing"))

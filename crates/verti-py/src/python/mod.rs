@@ -32,7 +32,9 @@ use verti_env::{
     TaskFilter, VecCore, encode_observation, outcome_code,
 };
 use verti_sim::{Controls, SimError, SpecError, VehicleSpec};
-use verti_world::generate::{SetConfig, composition, elevation::ProceduralRock, generate_world};
+use verti_world::generate::elevation::ElevationSource;
+use verti_world::generate::sources::ElevationRegistry;
+use verti_world::generate::{SetConfig, composition, generate_world};
 use verti_world::{ElevationLevel, ObstacleDensity, TaskId, TerrainType, World, WorldError};
 
 pyo3::create_exception!(

@@ -8,11 +8,35 @@ pub struct PyWorld {
     pub inner: Arc<World>,
 }
 
+/// The elevation source a generate call names (as `verti world sources` lists them: the
+/// default `procedural-rock`, the other procedural ones, the trained `swae-v1`), with its
+/// parameters from a dict checked as the command line's are.
+pub(super) fn elevation_source(
+    name: &str,
+    params: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Box<dyn ElevationSource>> {
+    let mut registry = ElevationRegistry::new();
+    verti_world::generate::sources::register(&mut registry);
+    verti_nn::shipped::register_sources(&mut registry);
+    let mut given = Vec::new();
+    if let Some(d) = params {
+        for (k, v) in d.iter() {
+            let k: String = k.extract()?;
+            let value = param_value(&k, &v)?;
+            given.push((k, value));
+        }
+    }
+    registry
+        .create(name, &given)
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
 pub(super) fn generate_one(
     seed: u64,
     index: u32,
     count: u32,
     scale: f64,
+    source: &dyn ElevationSource,
 ) -> Result<World, WorldError> {
     let config = SetConfig {
         seed,
@@ -27,7 +51,7 @@ pub(super) fn generate_one(
         )));
     }
     let (l, t, d) = composition(&config)[index as usize - 1];
-    generate_world(&config, index, l, t, d, &ProceduralRock::default())
+    generate_world(&config, index, l, t, d, source)
 }
 
 pub(super) fn obstacle_dict<'py>(
@@ -50,24 +74,43 @@ pub(super) fn obstacle_dict<'py>(
 #[pymethods]
 impl PyWorld {
     /// World `index` (1-based) of the generated set (seed, count, scale); the same world as
-    /// `verti world generate` writes. Generates only that world.
+    /// `verti world generate` writes. Generates only that world. `elevation` names the
+    /// elevation source (`verti world sources`; default `procedural-rock`, e.g. `swae-v1`)
+    /// and `elevation_params` its parameters.
     #[staticmethod]
-    #[pyo3(signature = (seed = 0, index = 1, count = 100, scale = 1.0))]
+    #[pyo3(signature = (seed = 0, index = 1, count = 100, scale = 1.0, elevation = "procedural-rock", elevation_params = None))]
+    #[allow(clippy::too_many_arguments)]
     fn generate(
         py: Python<'_>,
         seed: u64,
         index: u32,
         count: u32,
         scale: f64,
+        elevation: &str,
+        elevation_params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<PyWorld> {
-        let w = detached(py, || generate_one(seed, index, count, scale))?.map_err(world_err)?;
+        let source = elevation_source(elevation, elevation_params)?;
+        let w = detached(py, || {
+            generate_one(seed, index, count, scale, source.as_ref())
+        })?
+        .map_err(world_err)?;
         Ok(PyWorld { inner: Arc::new(w) })
     }
 
-    /// Every world of a generated set, in parallel (Ctrl-C stops it).
+    /// Every world of a generated set, in parallel (Ctrl-C stops it); `elevation` and
+    /// `elevation_params` as for `generate`.
     #[staticmethod]
-    #[pyo3(signature = (seed = 0, count = 100, scale = 1.0))]
-    fn generate_set(py: Python<'_>, seed: u64, count: u32, scale: f64) -> PyResult<Vec<PyWorld>> {
+    #[pyo3(signature = (seed = 0, count = 100, scale = 1.0, elevation = "procedural-rock", elevation_params = None))]
+    fn generate_set(
+        py: Python<'_>,
+        seed: u64,
+        count: u32,
+        scale: f64,
+        elevation: &str,
+        elevation_params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Vec<PyWorld>> {
+        let source = elevation_source(elevation, elevation_params)?;
+        let source = source.as_ref();
         let config = SetConfig {
             seed,
             count,
@@ -84,7 +127,7 @@ impl PyWorld {
                     if cancel.load(Ordering::Relaxed) {
                         return Err(WorldError::Argument("interrupted".into()));
                     }
-                    generate_world(&config, i as u32 + 1, l, t, d, &ProceduralRock::default())
+                    generate_world(&config, i as u32 + 1, l, t, d, source)
                 })
                 .collect()
         })?;
@@ -470,7 +513,14 @@ pub(super) fn load_worlds(
         && !std::path::Path::new(&spec).exists()
     {
         // generated sets: world by world, so Ctrl-C can stop between worlds
-        return PyWorld::generate_set(py, config.seed, config.count, config.scale);
+        return PyWorld::generate_set(
+            py,
+            config.seed,
+            config.count,
+            config.scale,
+            verti_world::generate::sources::DEFAULT_SOURCE,
+            None,
+        );
     }
     let cancel = AtomicBool::new(false);
     let set = interruptible(py, &cancel, || {
