@@ -156,7 +156,7 @@ def test_sim_rejects_bad_input(world):
 def test_vehicles_and_systems():
     assert "hmmwv" in verti.vehicles()
     names = [s["name"] for s in verti.systems()]
-    assert names == ["pid", "eh", "mppi", "oracle", "mppi6", "wmvct", "tal", "tnt"]
+    assert names == ["pid", "eh", "mppi", "oracle", "mppi6", "wmvct", "tal", "tnt", "rl", "mcl", "acl"]
     pid = verti.systems()[0]
     speed = next(p for p in pid["params"] if p["name"] == "speed")
     assert speed["type"] == "float" and speed["default"] == 3.0 and speed["max"] == 30.0
@@ -213,6 +213,16 @@ def test_learned_planners_run_from_python(world):
     for name in ["tal", "tnt"]:
         r = verti.evaluate(name, [world], tasks=[1], jobs=1, max_time=2.0, params={"samples": 32})
         assert r[0]["system"] == name and r[0]["path_length"] > 0.5
+
+
+def test_trained_policies_run_from_python(world):
+    # rl, mcl and acl: the PPO policies that ship, driven through the benchmark's trial
+    strip = lambda rs: [{k: v for k, v in x.items() if k != "wall_time"} for x in rs]  # noqa: E731
+    for name in ["rl", "mcl", "acl"]:
+        r = verti.evaluate(name, [world], tasks=[1, 2], jobs=1)
+        assert [x["system"] for x in r] == [name, name]
+        assert all(x["outcome"] in verti.OUTCOMES for x in r)
+        assert strip(verti.evaluate(name, [world], tasks=[1, 2], jobs=2)) == strip(r)
 
 
 def test_evaluate_writes_a_resumable_results_folder(world, tmp_path):

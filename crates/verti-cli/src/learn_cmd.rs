@@ -14,6 +14,77 @@ pub enum LearnCommand {
     Patch(PatchArgs),
     /// Train a learned kinodynamic model (`mppi6`, `wmvct`, `tal`) or TNT's traversability network (`tnt`) on random-exploration data.
     Kino(KinoArgs),
+    /// Train a driving policy with PPO (`rl`, `mcl` or `acl` by curriculum) on training worlds.
+    Rl(RlArgs),
+    /// Compare learning curves of `verti learn rl` runs (their `-log.csv` files), grouped by
+    /// name: `none-s1-log.csv` and `none-s2-log.csv` are two seeds of group `none`.
+    Curves(CurvesArgs),
+}
+
+#[derive(Args)]
+pub struct CurvesArgs {
+    /// `-log.csv` files of `verti learn rl` runs, named GROUP-sSEED-log.csv.
+    #[arg(required = true)]
+    pub logs: Vec<PathBuf>,
+    /// Chart to write.
+    #[arg(long, default_value = "curricula.png")]
+    pub out: PathBuf,
+    #[arg(long, default_value = "validation success of the three curricula")]
+    pub title: String,
+}
+
+#[derive(Args)]
+pub struct RlArgs {
+    /// Which tasks episodes drive: none (uniform: the `rl` system), manual (stages over
+    /// elevation, ground and obstacles: `mcl`) or auto (prioritised replay by TD error: `acl`).
+    #[arg(long, value_parser = ["none", "manual", "auto"], default_value = "none")]
+    pub curriculum: String,
+    /// Wall-clock budget, minutes (training stops after the update that spends it).
+    #[arg(long, default_value_t = 60.0)]
+    pub budget: f64,
+    /// Stop after this many updates (a reproducible length; the card records the count).
+    #[arg(long)]
+    pub updates: Option<u64>,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Training worlds (never verti-100).
+    #[arg(long, default_value = "verti-100-s1")]
+    pub worlds: String,
+    /// Validation worlds for the learning curve.
+    #[arg(long, default_value = "verti-100-s2")]
+    pub val_worlds: String,
+    /// Validation tasks, spread evenly over the validation worlds.
+    #[arg(long, default_value_t = 50)]
+    pub val_tasks: usize,
+    /// Validate every this many updates.
+    #[arg(long, default_value_t = 40)]
+    pub eval_every: u64,
+    #[arg(long, default_value = "hmmwv")]
+    pub vehicle: String,
+    /// Policy card to write (default models/SYSTEM-v1.yaml; weights, curve and log beside it).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Parallel environments.
+    #[arg(long, default_value_t = 16)]
+    pub envs: usize,
+    /// Control steps per environment per update.
+    #[arg(long, default_value_t = 256)]
+    pub steps: usize,
+    #[arg(long, default_value_t = 5)]
+    pub epochs: usize,
+    #[arg(long, default_value_t = 1024)]
+    pub minibatch: usize,
+    #[arg(long, default_value_t = 5e-4)]
+    pub lr: f64,
+    #[arg(long, default_value_t = 0.0)]
+    pub ent_coef: f64,
+    /// Threads stepping the environments (results depend on the seed, not on this count).
+    #[arg(long, default_value_t = 2)]
+    pub threads: usize,
+    /// Continue from the checkpoint beside --out (`<stem>.ckpt/`, written at every
+    /// validation), counting the time already spent toward --budget.
+    #[arg(long)]
+    pub resume: bool,
 }
 
 #[derive(Args)]
@@ -199,6 +270,8 @@ mod with_burn {
         let device = verti_learn::training_device();
         match cmd {
             LearnCommand::Kino(a) => crate::learn_kino::run(&a, &command_line(), &device),
+            LearnCommand::Rl(a) => crate::learn_rl::run(&a, &command_line(), &device),
+            LearnCommand::Curves(a) => crate::learn_rl::curves(&a),
             LearnCommand::Swae(a) => run_autoencoder(Autoencoder::Swae(a), &device),
             LearnCommand::Patch(a) => run_autoencoder(Autoencoder::Patch(a), &device),
         }

@@ -7,6 +7,8 @@ mod kino_cmd;
 mod learn_cmd;
 #[cfg(feature = "learn")]
 mod learn_kino;
+#[cfg(feature = "learn")]
+mod learn_rl;
 mod outputs;
 mod progress;
 mod registries;

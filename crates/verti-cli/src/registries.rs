@@ -12,6 +12,9 @@ pub fn systems() -> SystemRegistry {
     // the learned planners (MPPI over shipped kinodynamic models), evaluated without burn
     verti_kino::systems::register(&mut r, verti_kino::shipped::systems())
         .expect("learned system names are unique");
+    // the driving policies trained with PPO (rl, mcl, acl), evaluated without burn
+    verti_policy::system::register(&mut r, verti_policy::shipped::systems())
+        .expect("policy system names are unique");
     r
 }
 

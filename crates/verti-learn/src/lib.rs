@@ -9,10 +9,13 @@
 pub use burn::tensor::Device;
 
 pub mod commands;
+pub mod curriculum;
 pub mod elev_maps;
 pub mod kino;
 pub mod kino_command;
 pub mod patches;
+pub mod ppo;
+pub mod rl;
 pub mod seq;
 pub mod swae;
 pub mod tal;

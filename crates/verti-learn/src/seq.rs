@@ -3,10 +3,11 @@
 //! exported network computes the same function (checked by the tests).
 
 use burn::module::Module;
+use burn::module::Param;
 use burn::nn::conv::{Conv2d, Conv2dConfig, ConvTranspose2d, ConvTranspose2dConfig};
 use burn::nn::{Linear, LinearConfig, PaddingConfig2d};
 use burn::tensor::activation::{leaky_relu, relu, tanh};
-use burn::tensor::{Device, Tensor};
+use burn::tensor::{Device, Tensor, TensorData};
 use verti_nn::{LayerSpec, Shape};
 
 /// A batch of activations: flat `[batch, n]` or images `[batch, c, h, w]`.
@@ -146,6 +147,52 @@ impl SeqNet {
             };
         }
         x
+    }
+
+    /// Replaces the parameters of a network of linear layers (and activations) with
+    /// `params` in `verti-nn`'s order and layout, the inverse of [`SeqNet::export_params`]
+    /// (resuming training from an exported checkpoint).
+    pub fn import_params(mut self, params: &[f32], device: &Device) -> Result<SeqNet, String> {
+        let mut at = 0;
+        let mut li = 0;
+        for l in &self.layers {
+            match *l {
+                LayerSpec::Linear { inputs, outputs } => {
+                    let (w, b) = (inputs * outputs, outputs);
+                    if at + w + b > params.len() {
+                        return Err(format!(
+                            "{} parameters given, layer {li} needs more",
+                            params.len()
+                        ));
+                    }
+                    let m = &mut self.linears[li];
+                    m.weight = Param::from_tensor(Tensor::from_data(
+                        TensorData::new(params[at..at + w].to_vec(), [inputs, outputs]),
+                        device,
+                    ));
+                    m.bias = Some(Param::from_tensor(Tensor::from_data(
+                        TensorData::new(params[at + w..at + w + b].to_vec(), [outputs]),
+                        device,
+                    )));
+                    at += w + b;
+                    li += 1;
+                }
+                LayerSpec::Relu | LayerSpec::Tanh | LayerSpec::LeakyRelu { .. } => {}
+                ref other => {
+                    return Err(format!(
+                        "importing parameters into a {} layer is not supported",
+                        other.kind()
+                    ));
+                }
+            }
+        }
+        if at != params.len() {
+            return Err(format!(
+                "{} parameters given, the network has {at}",
+                params.len()
+            ));
+        }
+        Ok(self)
     }
 
     /// Every parameter in `verti-nn`'s order and layout (per layer: weights, then biases).

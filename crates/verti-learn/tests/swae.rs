@@ -8,6 +8,14 @@ use verti_learn::seq::{Act, SeqNet, values};
 use verti_learn::swae::{BatchSource, SwaeConfig, sliced_w2, train};
 use verti_nn::{ModelCard, Network, Shape, TrainingInfo, WeightsInfo};
 
+/// Burn draws initial weights from one process-wide generator that `device.seed` resets, so
+/// tests that build or train networks run one at a time (in parallel they would take each
+/// other's draws, and a training test would start from different weights run to run).
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    static BURN: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    BURN.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn tiny_config() -> SwaeConfig {
     SwaeConfig {
         side: 16,
@@ -53,6 +61,7 @@ fn card_for(net: &SeqNet) -> ModelCard {
 
 #[test]
 fn exported_networks_compute_what_burn_computes() {
+    let _burn = serial();
     let device = verti_learn::training_device();
     let cfg = tiny_config();
     for (input, layers) in [
@@ -94,6 +103,7 @@ fn matrix(v: Vec<f32>, shape: [usize; 2]) -> Tensor<2> {
 
 #[test]
 fn sliced_w2_of_a_shift_is_the_mean_squared_projected_shift() {
+    let _burn = serial();
     // shifting every sample by s keeps the sorted order along each direction, so each
     // direction θ contributes exactly (θ·s)²
     let mut rng = Rng::new(1);
@@ -126,6 +136,7 @@ fn sliced_w2_of_a_shift_is_the_mean_squared_projected_shift() {
 
 #[test]
 fn sliced_w2_gradient_matches_finite_differences() {
+    let _burn = serial();
     let mut rng = Rng::new(2);
     let (m, d, l) = (8, 2, 3);
     let a: Vec<f32> = (0..m * d).map(|_| rng.normal() as f32).collect();
@@ -182,6 +193,7 @@ impl BatchSource for Planes {
 
 #[test]
 fn a_tiny_swae_learns_a_two_parameter_family() {
+    let _burn = serial();
     let device = verti_learn::training_device();
     let cfg = tiny_config();
     let val = Planes.sample(&mut Rng::new(77), 64);
@@ -200,6 +212,7 @@ fn a_tiny_swae_learns_a_two_parameter_family() {
 
 #[test]
 fn bad_settings_are_named() {
+    let _burn = serial();
     let mut c = tiny_config();
     c.side = 12;
     assert!(c.validate().unwrap_err().contains("power of two"));

@@ -102,6 +102,9 @@ pub(super) fn system_registry() -> verti_bench::SystemRegistry {
     // the hybrids whose trained models ship (mppi6, wmvct, tal, tnt): no burn involved
     verti_kino::systems::register(&mut r, verti_kino::shipped::systems())
         .expect("the shipped learned systems have distinct names and valid parameters");
+    // the PPO driving policies (rl, mcl, acl)
+    verti_policy::system::register(&mut r, verti_policy::shipped::systems())
+        .expect("the shipped policies have distinct names and valid parameters");
     r
 }
 
