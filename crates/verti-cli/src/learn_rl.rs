@@ -147,16 +147,17 @@ pub fn curves(a: &CurvesArgs) -> Result<(), String> {
         }
     }
     let finals = verti_learn::rl::draw_comparison(&groups, &a.title, &a.out)?;
-    for ((name, runs), (_, last)) in groups.iter().zip(&finals) {
+    for ((name, runs), (_, last, area)) in groups.iter().zip(&finals) {
         let each: Vec<String> = runs
             .iter()
             .map(|r| format!("{:.0}", 100.0 * r.last().map_or(0.0, |p| p[1])))
             .collect();
         println!(
-            "{name}: final validation success {:.1} % (mean of {} runs: {} %)",
+            "{name}: final validation success {:.1} % (mean of {} runs: {} %); mean over the run {:.1} %",
             100.0 * last,
             runs.len(),
-            each.join(", ")
+            each.join(", "),
+            100.0 * area
         );
     }
     println!("wrote {}", a.out.display());

@@ -605,12 +605,13 @@ pub fn read_log(path: &Path) -> Result<Vec<[f64; 2]>, String> {
 
 /// Learning curves of several runs grouped by name (e.g. curriculum): per group the mean
 /// validation success over its runs at each validation point (runs of one group share the
-/// schedule). Returns per group the final mean.
+/// schedule). Returns per group the final mean and the mean over all validation points (the
+/// area under the curve, which says how fast a curriculum learns).
 pub fn draw_comparison(
     groups: &[(String, Vec<Vec<[f64; 2]>>)],
     title: &str,
     out: &Path,
-) -> Result<Vec<(String, f64)>, String> {
+) -> Result<Vec<(String, f64, f64)>, String> {
     let mut series = Vec::new();
     let mut finals = Vec::new();
     for (name, runs) in groups {
@@ -625,7 +626,8 @@ pub fn draw_comparison(
                 [x / 1e6, 100.0 * y]
             })
             .collect();
-        finals.push((name.clone(), mean[n - 1][1] / 100.0));
+        let area = mean.iter().map(|p| p[1]).sum::<f64>() / (100.0 * n as f64);
+        finals.push((name.clone(), mean[n - 1][1] / 100.0, area));
         series.push(LineSeries {
             name: format!("{name} (mean of {})", runs.len()),
             points: mean,
