@@ -195,7 +195,7 @@ impl TravMap {
 mod tests {
     use super::*;
     use verti_core::Rng;
-    use verti_nn::{LayerSpec, ModelCard, TrainingInfo, WeightsInfo};
+    use verti_nn::{LayerSpec, ModelCard};
 
     fn random_net() -> Arc<Network> {
         let conv = |i, o, k| LayerSpec::Conv2d {
@@ -216,30 +216,7 @@ mod tests {
         let n: usize = layers.iter().map(|l| l.parameter_count()).sum();
         let mut rng = Rng::new(5);
         let params: Vec<f32> = (0..n).map(|_| rng.normal() as f32 * 0.3).collect();
-        let card = ModelCard {
-            name: "trav".into(),
-            format: verti_nn::card::CARD_FORMAT,
-            summary: "test".into(),
-            input: Shape::Image([CHANNELS, FIELD, FIELD]),
-            layers,
-            normalisation: "none".into(),
-            weights: WeightsInfo {
-                file: "trav.bin".into(),
-                floats: 0,
-                fnv1a64: String::new(),
-            },
-            training: TrainingInfo {
-                data: "none".into(),
-                command: "none".into(),
-                seed: 0,
-                steps: 0,
-                wall_time_s: 0.0,
-                verti_version: "test".into(),
-                settings: String::new(),
-            },
-            metrics: Default::default(),
-            constants: Default::default(),
-        };
+        let card = ModelCard::new("trav", Shape::Image([CHANNELS, FIELD, FIELD]), layers);
         Arc::new(Network::from_params(card, &params).unwrap())
     }
 

@@ -7,7 +7,7 @@
 //! schedule, and record the validation loss now and then; export every member as a verti-nn
 //! network and the whole as a kinodynamic model card.
 
-use crate::seq::{Act, SeqNet, values};
+use crate::seq::{Act, SeqNet, mlp_layers, values};
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor, TensorData};
 use std::collections::BTreeMap;
@@ -17,7 +17,7 @@ use verti_core::Rng;
 use verti_kino::card::{KINO_FORMAT, KinoCard, KinoFile, KinoKind, KinoTraining};
 use verti_kino::features::{INPUT_DIM, OUTPUT_DIM, Standardiser, input_names};
 use verti_kino::samples::Examples;
-use verti_nn::{LayerSpec, ModelCard, Network, Shape, TrainingInfo, WeightsInfo};
+use verti_nn::{LayerSpec, ModelCard, Network, Shape, TrainingInfo};
 
 /// Training settings.
 #[derive(Clone, Debug, PartialEq)]
@@ -63,21 +63,12 @@ impl KinoConfig {
 
     /// The network's layers: inputs → hidden (ReLU) → outputs.
     pub fn layers(&self) -> Vec<LayerSpec> {
-        let mut layers = Vec::new();
-        let mut width = INPUT_DIM;
-        for &h in &self.hidden {
-            layers.push(LayerSpec::Linear {
-                inputs: width,
-                outputs: h,
-            });
-            layers.push(LayerSpec::Relu);
-            width = h;
-        }
-        layers.push(LayerSpec::Linear {
-            inputs: width,
-            outputs: self.kind.network_outputs(),
-        });
-        layers
+        mlp_layers(
+            INPUT_DIM,
+            &self.hidden,
+            self.kind.network_outputs(),
+            LayerSpec::Relu,
+        )
     }
 }
 
@@ -185,17 +176,8 @@ pub(crate) fn export_network(
     wall: f64,
 ) -> Result<Arc<Network>, String> {
     let card = ModelCard {
-        name: file.to_string(),
-        format: verti_nn::card::CARD_FORMAT,
         summary: summary.to_string(),
-        input: net.input_shape(),
-        layers: net.layers().to_vec(),
         normalisation: format!("see {}.yaml", prov.name),
-        weights: WeightsInfo {
-            file: format!("{file}.bin"),
-            floats: 0,
-            fnv1a64: String::new(),
-        },
         training: TrainingInfo {
             data: prov.data.clone(),
             command: prov.command.clone(),
@@ -205,8 +187,7 @@ pub(crate) fn export_network(
             verti_version: format!("verti {}", env!("CARGO_PKG_VERSION")),
             settings: String::new(),
         },
-        metrics: BTreeMap::new(),
-        constants: BTreeMap::new(),
+        ..ModelCard::new(file, net.input_shape(), net.layers().to_vec())
     };
     Network::from_params(card, &net.export_params())
         .map(Arc::new)

@@ -20,7 +20,7 @@
 //! draw (action noise, tasks, minibatch order) happens on the calling thread in a fixed order.
 
 use crate::curriculum::{TaskMeta, TaskSampler};
-use crate::seq::{Act, SeqNet, values};
+use crate::seq::{Act, SeqNet, mlp_layers, values};
 use burn::module::{Module, ModuleVisitor, Param};
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Tensor, TensorData};
@@ -30,7 +30,7 @@ use std::time::Instant;
 use verti_bench::episode::Outcome;
 use verti_core::Rng;
 use verti_env::{EnvCore, EnvError, ObsBuf, StepReport};
-use verti_nn::{LayerSpec, Mlp, ModelCard, Network, Shape, TrainingInfo, WeightsInfo};
+use verti_nn::{LayerSpec, Mlp, ModelCard, Network, Shape};
 use verti_policy::inputs::{INPUT_DIM, policy_input};
 use verti_policy::policy::{ACTION_DIM, LOG_STD};
 
@@ -130,21 +130,7 @@ impl PpoConfig {
 
     /// Layers of a network from the policy's inputs to `outputs` (tanh hidden layers).
     pub fn layers(&self, outputs: usize) -> Vec<LayerSpec> {
-        let mut layers = Vec::new();
-        let mut width = INPUT_DIM;
-        for &h in &self.hidden {
-            layers.push(LayerSpec::Linear {
-                inputs: width,
-                outputs: h,
-            });
-            layers.push(LayerSpec::Tanh);
-            width = h;
-        }
-        layers.push(LayerSpec::Linear {
-            inputs: width,
-            outputs,
-        });
-        layers
+        mlp_layers(INPUT_DIM, &self.hidden, outputs, LayerSpec::Tanh)
     }
 }
 
@@ -252,28 +238,8 @@ fn clip_global_norm(module: &ActorCritic, grads: &mut GradientsParams, max_norm:
 /// A network of the module as a verti-nn network, for rollouts, evaluation and files.
 pub fn export(net: &SeqNet, name: &str, constants: BTreeMap<String, Vec<f64>>) -> Network {
     let card = ModelCard {
-        name: name.to_string(),
-        format: verti_nn::card::CARD_FORMAT,
-        summary: String::new(),
-        input: net.input_shape(),
-        layers: net.layers().to_vec(),
-        normalisation: String::new(),
-        weights: WeightsInfo {
-            file: format!("{name}.bin"),
-            floats: 0,
-            fnv1a64: String::new(),
-        },
-        training: TrainingInfo {
-            data: String::new(),
-            command: String::new(),
-            seed: 0,
-            steps: 0,
-            wall_time_s: 0.0,
-            verti_version: format!("verti {}", env!("CARGO_PKG_VERSION")),
-            settings: String::new(),
-        },
-        metrics: BTreeMap::new(),
         constants,
+        ..ModelCard::new(name, net.input_shape(), net.layers().to_vec())
     };
     Network::from_params(card, &net.export_params()).expect("a module's own layers are valid")
 }

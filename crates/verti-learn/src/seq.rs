@@ -10,6 +10,31 @@ use burn::tensor::activation::{leaky_relu, relu, tanh};
 use burn::tensor::{Device, Tensor, TensorData};
 use verti_nn::{LayerSpec, Shape};
 
+/// The layers of a fully connected network: `inputs` → each of `hidden` (followed by
+/// `activation`) → `outputs`, no activation after the last layer.
+pub fn mlp_layers(
+    inputs: usize,
+    hidden: &[usize],
+    outputs: usize,
+    activation: LayerSpec,
+) -> Vec<LayerSpec> {
+    let mut layers = Vec::new();
+    let mut width = inputs;
+    for &h in hidden {
+        layers.push(LayerSpec::Linear {
+            inputs: width,
+            outputs: h,
+        });
+        layers.push(activation.clone());
+        width = h;
+    }
+    layers.push(LayerSpec::Linear {
+        inputs: width,
+        outputs,
+    });
+    layers
+}
+
 /// A batch of activations: flat `[batch, n]` or images `[batch, c, h, w]`.
 #[derive(Clone, Debug)]
 pub enum Act {

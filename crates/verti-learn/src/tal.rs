@@ -9,7 +9,7 @@
 //! export the three networks and one kinodynamic card.
 
 use crate::kino::{KinoConfig, KinoCurvePoint, KinoProvenance, KinoReport, export_network, rows};
-use crate::seq::{Act, SeqNet, values};
+use crate::seq::{Act, SeqNet, mlp_layers, values};
 use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor};
@@ -40,20 +40,7 @@ pub struct TalNet {
 }
 
 fn mlp(inputs: usize, hidden: &[usize], outputs: usize, last_relu: bool) -> Vec<LayerSpec> {
-    let mut layers = Vec::new();
-    let mut width = inputs;
-    for &h in hidden {
-        layers.push(LayerSpec::Linear {
-            inputs: width,
-            outputs: h,
-        });
-        layers.push(LayerSpec::Relu);
-        width = h;
-    }
-    layers.push(LayerSpec::Linear {
-        inputs: width,
-        outputs,
-    });
+    let mut layers = mlp_layers(inputs, hidden, outputs, LayerSpec::Relu);
     if last_relu {
         layers.push(LayerSpec::Relu);
     }

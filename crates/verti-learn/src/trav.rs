@@ -21,7 +21,7 @@ use verti_kino::samples::{Examples, KinoData};
 use verti_kino::traversability::{
     CHANNELS, FIELD, LABEL_HORIZON, OUTPUTS, RISK_ANGLE, SPACING, Traversability,
 };
-use verti_nn::{LayerSpec, ModelCard, Network, Shape, TrainingInfo, WeightsInfo};
+use verti_nn::{LayerSpec, ModelCard, Network, Shape, TrainingInfo};
 
 /// Channels of the two hidden convolutions.
 const WIDTH: usize = 8;
@@ -188,21 +188,12 @@ pub fn learn_trav(
     let baseline_loss = constant_baseline(&train, &val);
     let round = |v: f64| (v * 1e4).round() / 1e4;
     let card = ModelCard {
-        name: run.name.clone(),
-        format: verti_nn::card::CARD_FORMAT,
         summary: format!(
             "TNT's traversability: slopes along and across the heading on a {FIELD} x {FIELD} \
              lattice of {SPACING} m (full scale) → [largest |roll| or |pitch| over the next \
              {LABEL_HORIZON} s / {RISK_ANGLE} rad, 1 − distance made good / commanded]"
         ),
-        input,
-        layers: layers(),
         normalisation: "none: slopes are rise over run at full scale; labels as summarised".into(),
-        weights: WeightsInfo {
-            file: format!("{}.bin", run.name),
-            floats: 0,
-            fnv1a64: String::new(),
-        },
         training: TrainingInfo {
             data: format!(
                 "{} ({:.1} h, {}) for training, {} ({:.1} h, {}) for validation: {} and {} \
@@ -233,7 +224,7 @@ pub fn learn_trav(
                 round(baseline_loss),
             ),
         ]),
-        constants: BTreeMap::new(),
+        ..ModelCard::new(&run.name, input, layers())
     };
     let network =
         Arc::new(Network::from_params(card, &net.export_params()).map_err(|e| e.to_string())?);

@@ -6,7 +6,7 @@ use burn::tensor::{Tensor, TensorData};
 use verti_core::Rng;
 use verti_learn::seq::{Act, SeqNet, values};
 use verti_learn::swae::{BatchSource, SwaeConfig, sliced_w2, train};
-use verti_nn::{ModelCard, Network, Shape, TrainingInfo, WeightsInfo};
+use verti_nn::{ModelCard, Network, Shape};
 
 /// Burn draws initial weights from one process-wide generator that `device.seed` resets, so
 /// tests that build or train networks run one at a time (in parallel they would take each
@@ -33,30 +33,7 @@ fn tiny_config() -> SwaeConfig {
 }
 
 fn card_for(net: &SeqNet) -> ModelCard {
-    ModelCard {
-        name: "test".into(),
-        format: verti_nn::card::CARD_FORMAT,
-        summary: String::new(),
-        input: net.input_shape(),
-        layers: net.layers().to_vec(),
-        normalisation: String::new(),
-        weights: WeightsInfo {
-            file: "test.bin".into(),
-            floats: 0,
-            fnv1a64: String::new(),
-        },
-        training: TrainingInfo {
-            data: String::new(),
-            command: String::new(),
-            seed: 0,
-            steps: 0,
-            wall_time_s: 0.0,
-            verti_version: String::new(),
-            settings: String::new(),
-        },
-        metrics: Default::default(),
-        constants: Default::default(),
-    }
+    ModelCard::new("test", net.input_shape(), net.layers().to_vec())
 }
 
 #[test]

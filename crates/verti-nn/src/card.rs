@@ -44,7 +44,7 @@ pub struct WeightsInfo {
     pub fnv1a64: String,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TrainingInfo {
     /// What the model saw (files, world sets and their seeds).
@@ -58,6 +58,33 @@ pub struct TrainingInfo {
     pub verti_version: String,
     /// Optimiser, learning rate, batch size and the like, as text.
     pub settings: String,
+}
+
+impl ModelCard {
+    /// A card for a network of `layers` on `input`, weights in `NAME.bin`, with this verti's
+    /// version and nothing else said yet: trainers fill in what they know (struct update
+    /// syntax), tests use it as it is.
+    pub fn new(name: &str, input: Shape, layers: Vec<LayerSpec>) -> ModelCard {
+        ModelCard {
+            name: name.to_string(),
+            format: CARD_FORMAT,
+            summary: String::new(),
+            input,
+            layers,
+            normalisation: String::new(),
+            weights: WeightsInfo {
+                file: format!("{name}.bin"),
+                floats: 0,
+                fnv1a64: String::new(),
+            },
+            training: TrainingInfo {
+                verti_version: format!("verti {}", env!("CARGO_PKG_VERSION")),
+                ..TrainingInfo::default()
+            },
+            metrics: BTreeMap::new(),
+            constants: BTreeMap::new(),
+        }
+    }
 }
 
 /// FNV-1a, 64 bit: a dependency-free digest to catch truncated or swapped weight files.

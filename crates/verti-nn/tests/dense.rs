@@ -1,34 +1,10 @@
 //! The allocation-free MLP path gives exactly what the general network evaluator gives.
 
-use std::collections::BTreeMap;
 use verti_core::Rng;
-use verti_nn::{LayerSpec, Mlp, ModelCard, Network, Shape, TrainingInfo, WeightsInfo};
+use verti_nn::{LayerSpec, Mlp, ModelCard, Network, Shape};
 
 fn card(layers: Vec<LayerSpec>, inputs: usize) -> ModelCard {
-    ModelCard {
-        name: "mlp".into(),
-        format: verti_nn::card::CARD_FORMAT,
-        summary: "test".into(),
-        input: Shape::Flat(inputs),
-        layers,
-        normalisation: "none".into(),
-        weights: WeightsInfo {
-            file: "mlp.bin".into(),
-            floats: 0,
-            fnv1a64: String::new(),
-        },
-        training: TrainingInfo {
-            data: "none".into(),
-            command: "none".into(),
-            seed: 0,
-            steps: 0,
-            wall_time_s: 0.0,
-            verti_version: "test".into(),
-            settings: String::new(),
-        },
-        metrics: BTreeMap::new(),
-        constants: BTreeMap::new(),
-    }
+    ModelCard::new("mlp", Shape::Flat(inputs), layers)
 }
 
 fn random_network(layers: Vec<LayerSpec>, inputs: usize, rng: &mut Rng) -> Network {

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use verti_bench::episode::{EpisodeConfig, run_episode};
 use verti_env::{EnvCore, ObsBuf, TaskFilter};
-use verti_nn::{LayerSpec, ModelCard, Network, Shape, TrainingInfo, WeightsInfo};
+use verti_nn::{LayerSpec, ModelCard, Network, Shape};
 use verti_policy::inputs::{INPUT_DIM, env_config, policy_input};
 use verti_policy::system::PolicyDriver;
 use verti_policy::{Policy, shipped};
@@ -32,28 +32,8 @@ fn network(inputs: usize, constants: BTreeMap<String, Vec<f64>>) -> Network {
     let mut rng = verti_core::Rng::new(5);
     let params: Vec<f32> = (0..n).map(|_| rng.range(-0.3, 0.3) as f32).collect();
     let card = ModelCard {
-        name: "toy".into(),
-        format: verti_nn::card::CARD_FORMAT,
-        summary: String::new(),
-        input: Shape::Flat(inputs),
-        layers,
-        normalisation: String::new(),
-        weights: WeightsInfo {
-            file: "toy.bin".into(),
-            floats: 0,
-            fnv1a64: String::new(),
-        },
-        training: TrainingInfo {
-            data: String::new(),
-            command: String::new(),
-            seed: 0,
-            steps: 0,
-            wall_time_s: 0.0,
-            verti_version: String::new(),
-            settings: String::new(),
-        },
-        metrics: BTreeMap::new(),
         constants,
+        ..ModelCard::new("toy", Shape::Flat(inputs), layers)
     };
     Network::from_params(card, &params).unwrap()
 }
