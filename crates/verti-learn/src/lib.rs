@@ -14,6 +14,7 @@ pub mod elev_maps;
 pub mod kino;
 pub mod kino_command;
 pub mod patches;
+pub mod pietra;
 pub mod ppo;
 pub mod rl;
 pub mod seq;

@@ -1,0 +1,10 @@
+//! PIETRA and its baselines on burn: the losses ([`special`]), the networks ([`model`]), the
+//! benchmark's data ([`data`]), one training run ([`train`]) and the learning benchmark of the
+//! paper's Tables I–II and Fig. 6 ([`bench`]). The plain-Rust half (bins, physics prior, maps,
+//! dataset, CVaR) is `verti-pietra`.
+
+pub mod bench;
+pub mod data;
+pub mod model;
+pub mod special;
+pub mod train;

@@ -1,0 +1,16 @@
+//! PIETRA (Cai et al., RA-L 2025): physics-informed evidential traversability, in plain Rust.
+//! Training lives in `verti-learn` (burn); everything a planner and the benchmark need is here.
+//!
+//! * [`bins`]: the B = 12 bins of each traversability parameter and one-hot targets;
+//! * [`emd`]: EMD², its expectation under a Dirichlet (UEMD², closed form) and Dirichlet entropy;
+//! * [`cvar`]: left- and right-tail CVaR of a PMF;
+//! * [`prior`]: the physics prior of eqs. 15–18;
+//! * [`maps`]: the 30 synthetic rocky 50 m maps (train / validation / test);
+//! * [`dataset`]: driving them and extracting footprint features and targets.
+
+pub mod bins;
+pub mod cvar;
+pub mod dataset;
+pub mod emd;
+pub mod maps;
+pub mod prior;
