@@ -16,9 +16,49 @@ pub enum LearnCommand {
     Kino(KinoArgs),
     /// Train a driving policy with PPO (`rl`, `mcl` or `acl` by curriculum) on training worlds.
     Rl(RlArgs),
+    /// PIETRA's learning benchmark (`--benchmark`): the paper's Tables I-II and Fig. 6 on the
+    /// 30 PIETRA maps, every method over its hyper-parameter grid and seeds.
+    Pietra(PietraArgs),
     /// Compare learning curves of `verti learn rl` runs (their `-log.csv` files), grouped by
     /// name: `none-s1-log.csv` and `none-s2-log.csv` are two seeds of group `none`.
     Curves(CurvesArgs),
+}
+
+#[derive(Args)]
+pub struct PietraArgs {
+    /// Run the learning benchmark (drive the maps, sweep, write the tables).
+    #[arg(long)]
+    pub benchmark: bool,
+    /// Methods to train: all, or a list of pietra, pi, vanilla, evora, upi-only, pp-only.
+    #[arg(long, default_value = "all")]
+    pub methods: String,
+    /// Training seeds per configuration (paper: 5).
+    #[arg(long, default_value_t = 5)]
+    pub seeds: usize,
+    /// Adam steps per run (batch 256).
+    #[arg(long, default_value_t = 1500)]
+    pub steps: usize,
+    /// Exploration trials per map (paper: 20).
+    #[arg(long, default_value_t = 20)]
+    pub trials_per_map: u32,
+    /// Seed of the exploration trials.
+    #[arg(long, default_value_t = 0)]
+    pub data_seed: u64,
+    #[arg(long, default_value = "hmmwv")]
+    pub vehicle: String,
+    /// Worker processes training runs at once (default: one per core). Results do not depend
+    /// on it. Processes, not threads: burn's autodiff graph registry is one lock per process.
+    #[arg(long)]
+    pub workers: Option<usize>,
+    /// Keep the runs already finished in --out (a killed benchmark continues where it was).
+    #[arg(long)]
+    pub resume: bool,
+    /// Folder for tables.md, runs.csv, fig6.png and the finished runs (runs/).
+    #[arg(long, default_value = "results/pietra-bench")]
+    pub out: PathBuf,
+    /// Internal: this process is worker K of N (`K/N`), started by the benchmark itself.
+    #[arg(long, hide = true)]
+    pub worker: Option<String>,
 }
 
 #[derive(Args)]
@@ -272,6 +312,7 @@ mod with_burn {
             LearnCommand::Kino(a) => crate::learn_kino::run(&a, &command_line(), &device),
             LearnCommand::Rl(a) => crate::learn_rl::run(&a, &command_line(), &device),
             LearnCommand::Curves(a) => crate::learn_rl::curves(&a),
+            LearnCommand::Pietra(a) => crate::learn_pietra::run(&a, &command_line(), &device),
             LearnCommand::Swae(a) => run_autoencoder(Autoencoder::Swae(a), &device),
             LearnCommand::Patch(a) => run_autoencoder(Autoencoder::Patch(a), &device),
         }

@@ -8,6 +8,8 @@ mod learn_cmd;
 #[cfg(feature = "learn")]
 mod learn_kino;
 #[cfg(feature = "learn")]
+mod learn_pietra;
+#[cfg(feature = "learn")]
 mod learn_rl;
 mod outputs;
 mod progress;

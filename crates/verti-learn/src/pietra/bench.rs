@@ -8,11 +8,12 @@
 use super::data::{PietraData, Prepared};
 use super::model::{LossWeights, Method};
 use super::train::{
-    RunConfig, SampleErrors, Scores, Trained, physics_if_ood, physics_pmf, train,
-    train_log_density_min, uniform_errors,
+    RunConfig, SampleErrors, Scores, physics_if_ood, physics_pmf, train, train_log_density_min,
+    uniform_errors,
 };
 use burn::tensor::Device;
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -75,17 +76,57 @@ impl Grid {
     }
 }
 
-/// A run's scores (the network itself is dropped once scored, except the best ones' data).
-#[derive(Clone, Debug)]
+/// A run's scores, aggregated so that runs from other processes can be merged: mean EMD²
+/// overall / ID / OOD, per parameter, and per unevenness bin of Fig. 6.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunScores {
     pub config: RunConfig,
     pub val: f64,
-    pub test: Scores,
-    pub test_errors: SampleErrors,
+    pub test: Aggregate,
     pub wall_s: f64,
     pub final_loss: f64,
     /// For EVORA runs: the same network with the physics model where OOD.
-    pub phys_if_ood: Option<(Scores, SampleErrors)>,
+    pub phys_if_ood: Option<Aggregate>,
+    /// For evidential methods: how the flow's density sees the test samples.
+    pub density: Option<DensityStats>,
+}
+
+/// Whether the flow's density separates the (unevenness-defined) OOD test samples from the
+/// training data: the mean latent log-density of ID and OOD test samples, and the fraction of
+/// test samples below the lowest training density (what "use the physics model if OOD" flags).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DensityStats {
+    pub train_min: f64,
+    #[serde(with = "super::train::nan_as_null")]
+    pub test_id_mean: f64,
+    #[serde(with = "super::train::nan_as_null")]
+    pub test_ood_mean: f64,
+    pub flagged: f64,
+}
+
+/// A set of per-sample errors reduced to what the tables and Fig. 6 need.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Aggregate {
+    pub scores: Scores,
+    pub per_param: [f64; 4],
+    #[serde(with = "super::train::nan_as_null::vec")]
+    pub by_bin: Vec<f64>,
+}
+
+impl Aggregate {
+    pub fn of(errors: &SampleErrors, data: &PietraData, edges: &[f64]) -> Aggregate {
+        let mut per_param = [0.0; 4];
+        for p in &errors.per_param {
+            for k in 0..4 {
+                per_param[k] += p[k] / errors.per_param.len().max(1) as f64;
+            }
+        }
+        Aggregate {
+            scores: errors.scores(&data.test, data.threshold),
+            per_param,
+            by_bin: by_bin(errors, &data.test, edges),
+        }
+    }
 }
 
 /// One table row: a method's mean ± std over seeds of its chosen configuration.
@@ -102,6 +143,8 @@ pub struct Row {
     pub val: f64,
     /// Mean test error per unevenness bin (Fig. 6).
     pub by_bin: Vec<f64>,
+    /// The seeds' mean density statistics (evidential methods).
+    pub density: Option<DensityStats>,
 }
 
 /// What the benchmark produced.
@@ -121,27 +164,46 @@ fn mean_std(v: &[f64]) -> (f64, f64) {
     (m, s)
 }
 
-fn score_run(data: &PietraData, t: &Trained, cfg: &RunConfig, device: &Device) -> RunScores {
-    let val = t.val.scores(&data.val, data.threshold).overall;
-    let test = t.test.scores(&data.test, data.threshold);
-    let phys_if_ood = (cfg.method == Method::Evora).then(|| {
-        let min = train_log_density_min(&t.net, data, device);
-        let e = physics_if_ood(&t.test, &data.test, min);
-        (e.scores(&data.test, data.threshold), e)
+/// Trains and scores one configuration.
+pub fn score(data: &PietraData, cfg: &RunConfig, device: &Device) -> Result<RunScores, String> {
+    let t = train(data, cfg, device)?;
+    let edges = bin_edges(&data.test);
+    let min = cfg
+        .method
+        .evidential()
+        .then(|| train_log_density_min(&t.net, data, device));
+    let phys_if_ood = min
+        .filter(|_| cfg.method == Method::Evora)
+        .map(|min| Aggregate::of(&physics_if_ood(&t.test, &data.test, min), data, &edges));
+    let density = min.map(|train_min| {
+        let d = &t.test.log_density;
+        let mean = |id: bool| {
+            let v: Vec<f64> = (0..data.test.n)
+                .filter(|&i| data.test.is_id(i, data.threshold) == id)
+                .map(|i| d[i])
+                .collect();
+            v.iter().sum::<f64>() / v.len() as f64
+        };
+        DensityStats {
+            train_min,
+            test_id_mean: mean(true),
+            test_ood_mean: mean(false),
+            flagged: d.iter().filter(|v| **v < train_min).count() as f64 / d.len().max(1) as f64,
+        }
     });
-    RunScores {
+    Ok(RunScores {
         config: *cfg,
-        val,
-        test,
-        test_errors: t.test.clone(),
+        val: t.val.scores(&data.val, data.threshold).overall,
+        test: Aggregate::of(&t.test, data, &edges),
         wall_s: t.wall_s,
         final_loss: t.final_loss,
         phys_if_ood,
-    }
+        density,
+    })
 }
 
 /// Unevenness bins of Fig. 6: ten equal-count bins of the test samples.
-fn bin_edges(test: &Prepared) -> Vec<f64> {
+pub fn bin_edges(test: &Prepared) -> Vec<f64> {
     let mut u = test.unevenness.clone();
     u.sort_by(f64::total_cmp);
     if u.is_empty() {
@@ -152,16 +214,14 @@ fn bin_edges(test: &Prepared) -> Vec<f64> {
         .collect()
 }
 
-fn by_bin(errors: &[&SampleErrors], test: &Prepared, edges: &[f64]) -> Vec<f64> {
+fn by_bin(errors: &SampleErrors, test: &Prepared, edges: &[f64]) -> Vec<f64> {
     let nb = edges.len() - 1;
     let (mut sum, mut n) = (vec![0.0; nb], vec![0usize; nb]);
-    for e in errors {
-        for (i, v) in e.total.iter().enumerate() {
-            let u = test.unevenness[i];
-            let b = edges[1..nb].partition_point(|x| *x <= u).min(nb - 1);
-            sum[b] += v;
-            n[b] += 1;
-        }
+    for (i, v) in errors.total.iter().enumerate() {
+        let u = test.unevenness[i];
+        let b = edges[1..nb].partition_point(|x| *x <= u).min(nb - 1);
+        sum[b] += v;
+        n[b] += 1;
     }
     sum.iter()
         .zip(&n)
@@ -208,44 +268,78 @@ fn best<'a>(runs: &'a [RunScores], method: Method) -> Vec<&'a RunScores> {
         .unwrap_or_default()
 }
 
-fn test_pick(r: &RunScores) -> (Scores, &SampleErrors) {
-    (r.test, &r.test_errors)
+fn test_pick(r: &RunScores) -> &Aggregate {
+    &r.test
 }
 
-fn ood_pick(r: &RunScores) -> (Scores, &SampleErrors) {
-    let (s, e) = r.phys_if_ood.as_ref().expect("EVORA runs carry it");
-    (*s, e)
+fn ood_pick(r: &RunScores) -> &Aggregate {
+    r.phys_if_ood.as_ref().expect("EVORA runs carry it")
 }
 
-fn row_of(
-    name: &str,
-    group: &[&RunScores],
-    pick: fn(&RunScores) -> (Scores, &SampleErrors),
-    test: &Prepared,
-    edges: &[f64],
-) -> Row {
-    let scores: Vec<Scores> = group.iter().map(|r| pick(r).0).collect();
-    let errors: Vec<&SampleErrors> = group.iter().map(|r| pick(r).1).collect();
+fn row_of(name: &str, group: &[&RunScores], pick: fn(&RunScores) -> &Aggregate) -> Row {
+    let aggs: Vec<&Aggregate> = group.iter().map(|r| pick(r)).collect();
+    let n = aggs.len().max(1) as f64;
     let mut per_param = [0.0; 4];
-    for e in &errors {
-        for p in &e.per_param {
-            for k in 0..4 {
-                per_param[k] += p[k] / (e.per_param.len().max(1) * errors.len().max(1)) as f64;
-            }
+    for a in &aggs {
+        for k in 0..4 {
+            per_param[k] += a.per_param[k] / n;
         }
     }
+    let bins = aggs.first().map_or(0, |a| a.by_bin.len());
+    // every seed scores the same test samples, so the mean of bin means is the pooled mean
+    let by_bin = (0..bins)
+        .map(|b| aggs.iter().map(|a| a.by_bin[b]).sum::<f64>() / n)
+        .collect();
+    let field =
+        |f: fn(&Scores) -> f64| mean_std(&aggs.iter().map(|a| f(&a.scores)).collect::<Vec<_>>());
     Row {
         name: name.into(),
-        overall: mean_std(&scores.iter().map(|s| s.overall).collect::<Vec<_>>()),
-        id: mean_std(&scores.iter().map(|s| s.id).collect::<Vec<_>>()),
-        ood: mean_std(&scores.iter().map(|s| s.ood).collect::<Vec<_>>()),
+        overall: field(|s| s.overall),
+        id: field(|s| s.id),
+        ood: field(|s| s.ood),
         per_param,
         config: group
             .first()
             .map_or(String::new(), |r| config_name(&r.config)),
         val: mean_std(&group.iter().map(|r| r.val).collect::<Vec<_>>()).0,
-        by_bin: by_bin(&errors, test, edges),
+        by_bin,
+        density: mean_density(group),
     }
+}
+
+fn mean_density(group: &[&RunScores]) -> Option<DensityStats> {
+    let d: Vec<DensityStats> = group.iter().filter_map(|r| r.density).collect();
+    if d.is_empty() {
+        return None;
+    }
+    let m = |f: fn(&DensityStats) -> f64| d.iter().map(f).sum::<f64>() / d.len() as f64;
+    Some(DensityStats {
+        train_min: m(|x| x.train_min),
+        test_id_mean: m(|x| x.test_id_mean),
+        test_ood_mean: m(|x| x.test_ood_mean),
+        flagged: m(|x| x.flagged),
+    })
+}
+
+/// How each evidential row's flow sees the test samples, as Markdown.
+pub fn density_markdown(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "| Method | mean log p(z), ID test | mean log p(z), OOD test | lowest training log p(z) | test samples below it |\n|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        if let Some(d) = r.density {
+            let _ = writeln!(
+                s,
+                "| {} | {:.1} | {:.1} | {:.1} | {:.1} % |",
+                r.name,
+                d.test_id_mean,
+                d.test_ood_mean,
+                d.train_min,
+                100.0 * d.flagged
+            );
+        }
+    }
+    s
 }
 
 fn fixed_row(
@@ -255,26 +349,22 @@ fn fixed_row(
     val: &SampleErrors,
     edges: &[f64],
 ) -> Row {
-    let s = e.scores(&data.test, data.threshold);
-    let mut per_param = [0.0; 4];
-    for p in &e.per_param {
-        for k in 0..4 {
-            per_param[k] += p[k] / e.per_param.len().max(1) as f64;
-        }
-    }
+    let a = Aggregate::of(e, data, edges);
     Row {
         name: name.into(),
-        overall: (s.overall, 0.0),
-        id: (s.id, 0.0),
-        ood: (s.ood, 0.0),
-        per_param,
+        overall: (a.scores.overall, 0.0),
+        id: (a.scores.id, 0.0),
+        ood: (a.scores.ood, 0.0),
+        per_param: a.per_param,
         config: String::new(),
         val: val.scores(&data.val, data.threshold).overall,
-        by_bin: by_bin(&[e], &data.test, edges),
+        by_bin: a.by_bin,
+        density: None,
     }
 }
 
-/// Runs the whole grid for `methods` (progress is told after each run) and builds the tables.
+/// Runs the whole grid for `methods` in this process (runs in parallel on rayon's pool;
+/// `progress` is told after each run) and builds the tables.
 pub fn run_benchmark(
     data: &PietraData,
     grid: &Grid,
@@ -287,9 +377,8 @@ pub fn run_benchmark(
     let failures = Mutex::new(Vec::new());
     let runs: Vec<RunScores> = configs
         .par_iter()
-        .filter_map(|cfg| match train(data, cfg, device) {
-            Ok(t) => {
-                let r = score_run(data, &t, cfg, device);
+        .filter_map(|cfg| match score(data, cfg, device) {
+            Ok(r) => {
                 progress(&r);
                 Some(r)
             }
@@ -300,8 +389,22 @@ pub fn run_benchmark(
         })
         .collect();
     let failures = failures.into_inner().expect("no panics");
+    if !failures.is_empty() {
+        eprintln!("{} runs failed: {}", failures.len(), failures.join("; "));
+    }
+    let mut result = tables(data, runs, methods)?;
+    result.wall_s = started.elapsed().as_secs_f64();
+    Ok(result)
+}
+
+/// Table I, Table II and Fig. 6's curves from scored runs (of this or other processes).
+pub fn tables(
+    data: &PietraData,
+    runs: Vec<RunScores>,
+    methods: &[Method],
+) -> Result<BenchResult, String> {
     if runs.is_empty() {
-        return Err(format!("every run failed: {}", failures.join("; ")));
+        return Err("no run finished".into());
     }
     let edges = bin_edges(&data.test);
     let mut table1 = Vec::new();
@@ -316,13 +419,7 @@ pub fn run_benchmark(
     };
     for m in [Method::Pietra, Method::Pi, Method::Vanilla, Method::Evora] {
         if methods.contains(&m) {
-            table1.push(row_of(
-                label(m),
-                &best(&runs, m),
-                test_pick,
-                &data.test,
-                &edges,
-            ));
+            table1.push(row_of(label(m), &best(&runs, m), test_pick));
         }
     }
     let phys = SampleErrors::of_pmfs(&data.test, physics_pmf(&data.test));
@@ -337,7 +434,7 @@ pub fn run_benchmark(
     ));
     for m in [Method::Pietra, Method::UpiOnly, Method::PpOnly] {
         if methods.contains(&m) {
-            let mut r = row_of(label(m), &best(&runs, m), test_pick, &data.test, &edges);
+            let mut r = row_of(label(m), &best(&runs, m), test_pick);
             if m == Method::Pietra {
                 r.name = "PP & UPI (PIETRA)".into();
             }
@@ -346,24 +443,15 @@ pub fn run_benchmark(
     }
     if methods.contains(&Method::Evora) {
         let evora = best(&runs, Method::Evora);
-        table2.push(row_of(
-            "Use phys. model if OOD",
-            &evora,
-            ood_pick,
-            &data.test,
-            &edges,
-        ));
-        table2.push(row_of("EVORA", &evora, test_pick, &data.test, &edges));
-    }
-    if !failures.is_empty() {
-        eprintln!("{} runs failed: {}", failures.len(), failures.join("; "));
+        table2.push(row_of("Use phys. model if OOD", &evora, ood_pick));
+        table2.push(row_of("EVORA", &evora, test_pick));
     }
     Ok(BenchResult {
         runs,
         table1,
         table2,
         bin_edges: edges,
-        wall_s: started.elapsed().as_secs_f64(),
+        wall_s: 0.0,
     })
 }
 
@@ -415,9 +503,9 @@ pub fn runs_csv(runs: &[RunScores]) -> String {
             c.seed,
             c.steps,
             r.val,
-            r.test.overall,
-            r.test.id,
-            r.test.ood,
+            r.test.scores.overall,
+            r.test.scores.id,
+            r.test.scores.ood,
             r.final_loss,
             r.wall_s
         );

@@ -12,13 +12,14 @@ use super::special::cumsum_matrix;
 use crate::seq::values;
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor, TensorData};
+use serde::{Deserialize, Serialize};
 use std::time::Instant;
 use verti_core::Rng;
 use verti_pietra::bins::{B, PARAMS, Pmf, uniform};
 use verti_pietra::emd::emd2;
 
 /// One point of the sweep.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunConfig {
     pub method: Method,
     pub lr: f64,
@@ -38,11 +39,47 @@ pub struct SampleErrors {
 }
 
 /// Mean EMD² overall, on ID and on OOD samples.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Scores {
+    #[serde(with = "nan_as_null")]
     pub overall: f64,
+    #[serde(with = "nan_as_null")]
     pub id: f64,
+    #[serde(with = "nan_as_null")]
     pub ood: f64,
+}
+
+/// JSON has no NaN: a score of an empty set (no OOD samples, say) is written as null.
+pub mod nan_as_null {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if v.is_finite() {
+            s.serialize_f64(*v)
+        } else {
+            s.serialize_none()
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+    }
+
+    /// The same for every element of a vector.
+    pub mod vec {
+        use serde::{Deserialize, Deserializer, Serializer};
+
+        pub fn serialize<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+            s.collect_seq(v.iter().map(|x| x.is_finite().then_some(*x)))
+        }
+
+        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+            Ok(Vec::<Option<f64>>::deserialize(d)?
+                .into_iter()
+                .map(|x| x.unwrap_or(f64::NAN))
+                .collect())
+        }
+    }
 }
 
 impl SampleErrors {
