@@ -26,9 +26,27 @@ pub enum LearnCommand {
 
 #[derive(Args)]
 pub struct PietraArgs {
-    /// Run the learning benchmark (drive the maps, sweep, write the tables).
+    /// Run the learning benchmark (drive the maps, sweep, write the tables). Without it, train
+    /// one model for the planner (`--method`) and write it to `--model-out`.
     #[arg(long)]
     pub benchmark: bool,
+    /// The model to train without --benchmark: pietra, evora, vanilla, pi, upi-only, pp-only.
+    #[arg(long, default_value = "pietra")]
+    pub method: String,
+    /// Learning rate, physics-loss weight κ and entropy weight of the model (default: what the
+    /// benchmark chose for the method on validation).
+    #[arg(long)]
+    pub lr: Option<f64>,
+    #[arg(long)]
+    pub kappa: Option<f64>,
+    #[arg(long)]
+    pub entropy: Option<f64>,
+    /// Training seed of the model.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Model card to write (default models/METHOD-v1.yaml; networks beside it).
+    #[arg(long)]
+    pub model_out: Option<PathBuf>,
     /// Methods to train: all, or a list of pietra, pi, vanilla, evora, upi-only, pp-only.
     #[arg(long, default_value = "all")]
     pub methods: String,

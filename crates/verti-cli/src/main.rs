@@ -12,6 +12,7 @@ mod learn_pietra;
 #[cfg(feature = "learn")]
 mod learn_rl;
 mod outputs;
+mod pietra_cmd;
 mod progress;
 mod registries;
 mod vehicle_cmd;
@@ -59,6 +60,9 @@ enum Command {
     /// Datasets: random exploration, failure cases and expert demonstrations (Parquet).
     #[command(subcommand)]
     Data(data_cmd::DataCommand),
+    /// PIETRA: the 30 PIETRA maps, and the navigation benchmark (paper §V-D, Fig. 7).
+    #[command(subcommand)]
+    Pietra(pietra_cmd::PietraCommand),
 }
 
 #[derive(Subcommand)]
@@ -98,6 +102,7 @@ fn main() -> ExitCode {
         Command::Learn(cmd) => learn_cmd::run(cmd).map_err(Into::into),
         Command::Data(cmd) => data_cmd::run(cmd),
         Command::Kino(cmd) => kino_cmd::run(cmd),
+        Command::Pietra(cmd) => pietra_cmd::run(cmd).map_err(Into::into),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -15,6 +15,9 @@ pub fn systems() -> SystemRegistry {
     // the driving policies trained with PPO (rl, mcl, acl), evaluated without burn
     verti_policy::system::register(&mut r, verti_policy::shipped::systems())
         .expect("policy system names are unique");
+    // PIETRA's risk-aware planner over the shipped traversability model, evaluated without burn
+    verti_pietra::system::register(&mut r, verti_pietra::shipped::pietra_v1)
+        .expect("system names are unique");
     r
 }
 

@@ -238,3 +238,58 @@ fn the_benchmark_writes_both_tables() {
         1 + result.runs.len()
     );
 }
+
+#[test]
+fn the_exported_model_computes_what_burn_computes() {
+    use verti_learn::pietra::export::to_model;
+    let data = toy_data();
+    let device = dev();
+    for method in [Method::Pietra, Method::Vanilla, Method::Evora] {
+        let t = train(&data, &run(method, 2, 60), &device).unwrap();
+        let model = to_model(
+            &t.net,
+            &data,
+            -50.0,
+            verti_nn::TrainingInfo::default(),
+            BTreeMap::new(),
+            "toy-v1",
+        )
+        .unwrap();
+        // a round trip through the files changes nothing
+        let dir = std::env::temp_dir().join(format!("verti-pietra-export-{}", method.name()));
+        model.save(&dir.join("toy-v1.yaml")).unwrap();
+        let model = verti_pietra::model::TravModel::load(&dir.join("toy-v1.yaml")).unwrap();
+        let idx: Vec<usize> = (0..16).collect();
+        let (x, _, ph) = data.test.batch(&idx, &device);
+        let prior = if method.physics_in_posterior() {
+            ph
+        } else {
+            ph.ones_like() / B as f64
+        };
+        let (p, logd) = expected_pmf(&t.net, x, prior);
+        let (p, logd) = (values(p), values(logd));
+        let mut scratch = model.scratch();
+        for &i in &idx {
+            let f = &data.test.features[i * FEATURES..(i + 1) * FEATURES];
+            let physics: [verti_pietra::bins::Pmf; PARAMS] = std::array::from_fn(|k| {
+                std::array::from_fn(|b| f64::from(data.test.physics[(i * PARAMS + k) * B + b]))
+            });
+            let got = model.predict(f, &physics, &mut scratch);
+            for k in 0..PARAMS {
+                for b in 0..B {
+                    let want = f64::from(p[(i * PARAMS + k) * B + b]);
+                    assert!(
+                        (got.pmf[k][b] - want).abs() < 1e-4,
+                        "{} sample {i} param {k} bin {b}: {} vs {want}",
+                        method.name(),
+                        got.pmf[k][b]
+                    );
+                }
+            }
+            if method.evidential() {
+                let want = f64::from(logd[i]);
+                assert!((got.log_density - want).abs() < 1e-3 * want.abs().max(1.0));
+            }
+        }
+    }
+}

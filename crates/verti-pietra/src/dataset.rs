@@ -154,6 +154,11 @@ pub struct DataConfig {
     pub max_trial_seconds: f64,
     /// Trials end when the chassis comes this close to the map's edge, m.
     pub edge_margin: f64,
+    /// A trial is stuck when it made less than `stuck_distance` m in the last `stuck_window` s.
+    /// Shorter than the benchmark's 10 s: a stalled vehicle would otherwise fill the data with
+    /// ~100 identical samples per trial (on the rough test maps most trials end stuck).
+    pub stuck_window: f64,
+    pub stuck_distance: f64,
     /// Samples whose commanded yaw rate is below this (rad/s) are dropped: angular traction
     /// is a ratio and is meaningless there.
     pub min_yaw_rate: f64,
@@ -171,6 +176,8 @@ impl DataConfig {
             warmup: 3.0,
             max_trial_seconds: 120.0,
             edge_margin: 4.0,
+            stuck_window: 3.0,
+            stuck_distance: 0.5,
             min_yaw_rate: 0.05,
             seed: 0,
         }
@@ -259,6 +266,8 @@ fn drive_trial(
     let phase = rng.range(0.0, TAU);
     let episode = EpisodeConfig {
         max_time: cfg.max_trial_seconds,
+        stuck_window: cfg.stuck_window,
+        stuck_distance: cfg.stuck_distance,
         seed: rng.next_u64(),
         ..Default::default()
     };

@@ -6,11 +6,21 @@
 //! * [`cvar`]: left- and right-tail CVaR of a PMF;
 //! * [`prior`]: the physics prior of eqs. 15–18;
 //! * [`maps`]: the 30 synthetic rocky 50 m maps (train / validation / test);
-//! * [`dataset`]: driving them and extracting footprint features and targets.
+//! * [`dataset`]: driving them and extracting footprint features and targets;
+//! * [`model`]: a trained model (card + networks) evaluated in plain Rust;
+//! * [`cvar_map`]: CVaR maps over cells and 13 headings;
+//! * [`planner`]: risk-aware MPPI (CVaR dynamics, time-to-goal cost);
+//! * [`system`]: the `pietra` mobility system;
+//! * [`shipped`]: the trained `pietra-v1`, compiled in.
 
 pub mod bins;
 pub mod cvar;
+pub mod cvar_map;
 pub mod dataset;
 pub mod emd;
 pub mod maps;
+pub mod model;
+pub mod planner;
 pub mod prior;
+pub mod shipped;
+pub mod system;

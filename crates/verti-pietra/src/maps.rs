@@ -4,7 +4,7 @@
 //! distribution shift of the paper's Fig. 5).
 //!
 //! The rock fields come from verti's own procedural rock generator (the one behind verti-100),
-//! on a 0.5 m grid so rocks are one to two metres across — the scale of a rock testbed under a
+//! on a 0.39 m grid so rocks are one to two metres across — the scale of a rock testbed under a
 //! 3.4 m vehicle. Maps are a pure function of their index: nothing is stored on disk, and none
 //! of them is a verti-100 or original Verti-Bench world.
 
@@ -19,17 +19,20 @@ use verti_world::{
 
 /// Side of a map, metres.
 pub const SIDE: f64 = 50.0;
-/// Grid spacing, metres.
-pub const CELL: f64 = 0.5;
-/// Vertices per side.
-pub const VERTICES: usize = (SIDE / CELL) as usize + 1;
+/// Vertices per side: verti's world format (16 x 16 semantic patches of 8 cells), so the maps
+/// save, load and replay like any world.
+pub const VERTICES: usize = 129;
+/// Grid spacing, metres (0.39 m).
+pub const CELL: f64 = SIDE / (VERTICES - 1) as f64;
 /// Maps per split.
 pub const PER_SPLIT: u32 = 10;
-/// Height of a height fraction of 1 on training and validation maps, metres. The generator
-/// maps a rock field to a spread of 2.7–4.5 % of this (0.2–0.4 m standard deviation).
-pub const BASE_RELIEF: f64 = 8.0;
-/// Vertical scale of the test maps relative to training (the paper's "scaled more").
-pub const TEST_SCALE: f64 = 1.5;
+/// Height of a height fraction of 1 on training and validation maps, metres: verti's low
+/// elevation level (the generator maps a rock field to a spread of 2.7–4.5 % of this, 0.13–0.22
+/// m standard deviation).
+pub const BASE_RELIEF: f64 = 4.8;
+/// Vertical scale of the test maps relative to training (the paper's "scaled more"): the
+/// medium level, twice the relief.
+pub const TEST_SCALE: f64 = 2.0;
 /// Coulomb friction of the dirt (the class's mean friction in verti).
 pub const DIRT_FRICTION: f64 = 0.6;
 /// Distance between a navigation task's start and goal (paper: 40 m).
@@ -126,6 +129,7 @@ pub fn map(split: Split, index: u32) -> World {
                 set_seed: SEED,
                 generator: "pietra-rock-v1".into(),
             },
+            // the level whose maximum height is the relief, so the maps save and load as sets
             level: if split == Split::Test {
                 ElevationLevel::Mid
             } else {
@@ -177,7 +181,7 @@ mod tests {
             v.iter().sum::<f64>() / v.len() as f64
         };
         let (tr, te) = (mean(Split::Train), mean(Split::Test));
-        assert!(tr > 0.1 && tr < 0.5, "training relief std {tr}");
+        assert!(tr > 0.1 && tr < 0.3, "training relief std {tr}");
         assert!(te > 1.5 * tr, "test maps must be rougher: {te} vs {tr}");
     }
 

@@ -5,6 +5,7 @@
 
 pub mod bench;
 pub mod data;
+pub mod export;
 pub mod model;
 pub mod special;
 pub mod train;

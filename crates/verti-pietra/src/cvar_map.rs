@@ -1,0 +1,307 @@
+//! CVaR maps (paper §IV-D, §V-D): for every cell of a grid and each of 13 headings, the
+//! footprint a vehicle centred there would stand on, its traversability PMFs (a trained model's
+//! expected PMF, or the physics prior alone), reduced to the risk-aware values the planner
+//! reads: the left-tail CVaR_α of linear and angular traction and the right-tail CVaR_α of
+//! |roll| and |pitch|. Stored as a [4, 13, rows, cols] array, plus an OOD mask where the
+//! model's latent density is below the lowest it gave a training sample.
+
+use crate::bins::{Bins, PARAMS, Pmf};
+use crate::cvar::{cvar_left, cvar_right};
+use crate::dataset::{FEATURES, WheelLayout, footprint, footprint_patch};
+use crate::model::TravModel;
+use crate::prior::{PriorConfig, physics_prior};
+use rayon::prelude::*;
+use verti_world::Heightfield;
+
+/// Headings per cell: −180° to 180° in steps of 30°, both ends kept (the paper's 13).
+pub const YAWS: usize = 13;
+
+/// The heading of yaw bin `k`, radians.
+pub fn yaw_of(k: usize) -> f64 {
+    -std::f64::consts::PI + k as f64 * std::f64::consts::PI / 6.0
+}
+
+/// The nearest yaw bin to a heading.
+pub fn yaw_bin(yaw: f64) -> usize {
+    let a = (yaw + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU);
+    ((a / (std::f64::consts::PI / 6.0)).round() as usize).min(YAWS - 1)
+}
+
+/// A grid of cells: `cols` x `rows` of side `cell`, cell (0, 0) centred at (`x0`, `y0`), rows
+/// going +y, columns +x.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Region {
+    pub x0: f64,
+    pub y0: f64,
+    pub cell: f64,
+    pub cols: usize,
+    pub rows: usize,
+}
+
+impl Region {
+    /// The whole square map of `terrain` at `cell` metres.
+    pub fn whole(terrain: &Heightfield, cell: f64) -> Region {
+        let half = terrain.half_extent();
+        let n = ((2.0 * half) / cell).floor() as usize + 1;
+        Region {
+            x0: -half,
+            y0: -half,
+            cell,
+            cols: n,
+            rows: n,
+        }
+    }
+    /// A `cols` x `rows` window centred on (x, y).
+    pub fn around(x: f64, y: f64, cell: f64, cols: usize, rows: usize) -> Region {
+        Region {
+            x0: x - 0.5 * (cols as f64 - 1.0) * cell,
+            y0: y - 0.5 * (rows as f64 - 1.0) * cell,
+            cell,
+            cols,
+            rows,
+        }
+    }
+    pub fn cells(&self) -> usize {
+        self.cols * self.rows
+    }
+}
+
+/// Where the PMFs come from.
+#[derive(Clone, Copy)]
+pub enum Source<'a> {
+    /// The physics prior of eq. 18 alone.
+    Physics,
+    /// A trained model (its posterior includes the prior where it says so).
+    Model(&'a TravModel),
+}
+
+/// What the map is made of besides the source.
+#[derive(Clone, Debug)]
+pub struct MapSpec {
+    pub layout: WheelLayout,
+    pub prior: PriorConfig,
+    pub bins: [Bins; PARAMS],
+    /// Risk tolerance α ∈ (0, 1] (1: the mean).
+    pub alpha: f64,
+}
+
+/// The risk-aware traversability of a region.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CvarMap {
+    pub region: Region,
+    pub alpha: f64,
+    /// [param][yaw][row][col]: CVaR← of ψ1, ψ2 (traction, [0, 1]) and CVaR→ of ψ3, ψ4 (rad).
+    pub values: Vec<f32>,
+    /// [yaw][row][col]: latent density below the model's lowest training density.
+    pub ood: Vec<bool>,
+}
+
+/// The CVaR values and OOD flag of one footprint.
+pub fn footprint_cvar(
+    terrain: &Heightfield,
+    spec: &MapSpec,
+    source: Source,
+    x: f64,
+    y: f64,
+    yaw: f64,
+    scratch: &mut (Vec<f32>, Option<crate::model::TravScratch>),
+) -> ([f64; PARAMS], bool) {
+    let fp = footprint(terrain, &spec.layout, x, y, yaw);
+    let physics = physics_prior(&fp, &spec.prior, &spec.bins);
+    let (pmf, ood): ([Pmf; PARAMS], bool) = match source {
+        Source::Physics => (physics, false),
+        Source::Model(m) => {
+            scratch.0.resize(FEATURES, 0.0);
+            footprint_patch(terrain, x, y, yaw, &mut scratch.0);
+            let s = scratch.1.get_or_insert_with(|| m.scratch());
+            let p = m.predict(&scratch.0, &physics, s);
+            (p.pmf, p.log_density < m.card.ood_log_density)
+        }
+    };
+    let mut out = [0.0; PARAMS];
+    for k in 0..PARAMS {
+        let v = spec.bins[k].values();
+        out[k] = if k < 2 {
+            cvar_left(&pmf[k], &v, spec.alpha)
+        } else {
+            cvar_right(&pmf[k], &v, spec.alpha)
+        };
+    }
+    (out, ood)
+}
+
+impl CvarMap {
+    /// Computes the map of `region` (rows in parallel; the result does not depend on the
+    /// thread count).
+    pub fn build(terrain: &Heightfield, spec: &MapSpec, source: Source, region: Region) -> CvarMap {
+        let plane = region.cells();
+        let rows: Vec<(Vec<[f64; PARAMS]>, Vec<bool>)> = (0..region.rows)
+            .into_par_iter()
+            .map(|r| Self::row(terrain, spec, source, region, r))
+            .collect();
+        let mut values = vec![0.0f32; PARAMS * YAWS * plane];
+        let mut ood = vec![false; YAWS * plane];
+        for (r, (vals, flags)) in rows.into_iter().enumerate() {
+            for c in 0..region.cols {
+                for k in 0..YAWS {
+                    let i = c * YAWS + k;
+                    for (p, v) in vals[i].iter().enumerate() {
+                        values[(p * YAWS + k) * plane + r * region.cols + c] = *v as f32;
+                    }
+                    ood[k * plane + r * region.cols + c] = flags[i];
+                }
+            }
+        }
+        CvarMap {
+            region,
+            alpha: spec.alpha,
+            values,
+            ood,
+        }
+    }
+
+    /// The same on the calling thread only (what "one core" means in the speed benchmark).
+    pub fn build_serial(
+        terrain: &Heightfield,
+        spec: &MapSpec,
+        source: Source,
+        region: Region,
+    ) -> CvarMap {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .expect("a one-thread pool")
+            .install(|| Self::build(terrain, spec, source, region))
+    }
+
+    fn row(
+        terrain: &Heightfield,
+        spec: &MapSpec,
+        source: Source,
+        region: Region,
+        r: usize,
+    ) -> (Vec<[f64; PARAMS]>, Vec<bool>) {
+        let mut scratch = (Vec::new(), None);
+        let mut vals = Vec::with_capacity(region.cols * YAWS);
+        let mut flags = Vec::with_capacity(region.cols * YAWS);
+        let y = region.y0 + r as f64 * region.cell;
+        for c in 0..region.cols {
+            let x = region.x0 + c as f64 * region.cell;
+            for k in 0..YAWS {
+                let (v, o) = footprint_cvar(terrain, spec, source, x, y, yaw_of(k), &mut scratch);
+                vals.push(v);
+                flags.push(o);
+            }
+        }
+        (vals, flags)
+    }
+
+    /// Nearest cell of (x, y), if on the map.
+    #[inline]
+    fn cell_of(&self, x: f64, y: f64) -> Option<usize> {
+        let g = &self.region;
+        let c = ((x - g.x0) / g.cell).round();
+        let r = ((y - g.y0) / g.cell).round();
+        if c < 0.0 || r < 0.0 || c >= g.cols as f64 || r >= g.rows as f64 {
+            return None;
+        }
+        Some(r as usize * g.cols + c as usize)
+    }
+
+    /// CVaR values at (x, y) heading `yaw` (nearest cell and yaw bin); `None` off the map.
+    #[inline]
+    pub fn at(&self, x: f64, y: f64, yaw: f64) -> Option<[f32; PARAMS]> {
+        let i = self.cell_of(x, y)?;
+        let k = yaw_bin(yaw);
+        let plane = self.region.cells();
+        Some(std::array::from_fn(|p| {
+            self.values[(p * YAWS + k) * plane + i]
+        }))
+    }
+
+    /// Whether (x, y) heading `yaw` is out of the model's training distribution.
+    #[inline]
+    pub fn is_ood(&self, x: f64, y: f64, yaw: f64) -> bool {
+        self.cell_of(x, y)
+            .is_some_and(|i| self.ood[yaw_bin(yaw) * self.region.cells() + i])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bins::param_bins;
+
+    fn spec(alpha: f64) -> MapSpec {
+        MapSpec {
+            layout: WheelLayout {
+                wheels: [[1.7, 0.9], [-1.7, 0.9], [-1.7, -0.9], [1.7, -0.9]],
+                track: 1.8,
+                wheelbase: 3.4,
+            },
+            prior: PriorConfig::default(),
+            bins: param_bins(),
+            alpha,
+        }
+    }
+
+    #[test]
+    fn yaw_bins_round_trip() {
+        for k in 0..YAWS - 1 {
+            assert_eq!(yaw_bin(yaw_of(k)), k);
+        }
+        assert_eq!(yaw_bin(std::f64::consts::PI), 0);
+        assert_eq!(yaw_bin(0.2), 6);
+    }
+
+    #[test]
+    fn a_ramp_has_less_traction_climbing_than_across() {
+        // a 15° ramp rising towards +x
+        let n = 81;
+        let s = 15f64.to_radians().tan();
+        let h: Vec<f64> = (0..n * n)
+            .map(|i| s * ((i % n) as f64 - 40.0) * 0.5)
+            .collect();
+        let t = Heightfield::new(n, 0.5, h);
+        let m = CvarMap::build(
+            &t,
+            &spec(0.5),
+            Source::Physics,
+            Region::around(0.0, 0.0, 1.0, 5, 5),
+        );
+        let up = m.at(0.0, 0.0, 0.0).unwrap();
+        let across = m.at(0.0, 0.0, std::f64::consts::FRAC_PI_2).unwrap();
+        assert!(up[0] < across[0], "climbing {up:?} vs across {across:?}");
+        assert!(
+            up[3] > across[3],
+            "pitch climbing {} vs across {}",
+            up[3],
+            across[3]
+        );
+        assert!(
+            across[2] > up[2],
+            "roll across {} vs climbing {}",
+            across[2],
+            up[2]
+        );
+        assert!(m.at(100.0, 0.0, 0.0).is_none());
+        // a lower α is more pessimistic
+        let m2 = CvarMap::build(
+            &t,
+            &spec(0.1),
+            Source::Physics,
+            Region::around(0.0, 0.0, 1.0, 5, 5),
+        );
+        assert!(m2.at(0.0, 0.0, 0.0).unwrap()[0] <= up[0]);
+        // parallel and serial builds agree
+        assert_eq!(
+            m2,
+            CvarMap::build_serial(
+                &t,
+                &spec(0.1),
+                Source::Physics,
+                Region::around(0.0, 0.0, 1.0, 5, 5)
+            )
+        );
+    }
+}
