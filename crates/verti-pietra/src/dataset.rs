@@ -74,6 +74,29 @@ fn offset(x: f64, y: f64, yaw: f64, forward: f64, left: f64) -> (f64, f64) {
     (x + forward * c - left * s, y + forward * s + left * c)
 }
 
+/// Terrain height at continuous grid coordinates (column, row), clamped to the map: the
+/// triangle interpolation of [`Heightfield::sample`], without its slopes (the hot loop of
+/// feature extraction and CVaR maps).
+#[inline]
+fn height_on_grid(t: &Heightfield, gc: f64, gr: f64) -> f64 {
+    let n = t.size();
+    let m = (n - 1) as f64;
+    let (gc, gr) = (gc.clamp(0.0, m), gr.clamp(0.0, m));
+    let c0 = (gc as usize).min(n - 2);
+    let r0 = (gr as usize).min(n - 2);
+    let u = gc - c0 as f64;
+    let v = 1.0 - (gr - r0 as f64);
+    let sw = t.vertex(r0 + 1, c0);
+    let ne = t.vertex(r0, c0 + 1);
+    if u >= v {
+        let se = t.vertex(r0 + 1, c0 + 1);
+        sw + u * (se - sw) + v * (ne - se)
+    } else {
+        let nw = t.vertex(r0, c0);
+        sw + v * (nw - sw) + u * (ne - nw)
+    }
+}
+
 /// Fills `out` with the yaw-aligned footprint patch at (x, y, yaw), heights relative to the
 /// patch mean (row-major, forward rows first, left columns first), and returns the patch's
 /// unevenness (the standard deviation of its heights).
@@ -82,12 +105,19 @@ pub fn footprint_patch(terrain: &Heightfield, x: f64, y: f64, yaw: f64, out: &mu
     let mut h = [0.0f64; FEATURES];
     let half_l = 0.5 * (PATCH_LENGTH - 1) as f64;
     let half_w = 0.5 * (PATCH_WIDTH - 1) as f64;
+    // offsets in grid units: column grows with x, row grows with −y
+    let (gc0, gr0) = terrain.grid_coords(x, y);
+    let (s, c) = yaw.sin_cos();
+    let k = PATCH_CELL / terrain.cell();
+    let (fx, fy) = (c * k, s * k); // one cell forward, in (column, −row)
+    let (lx, ly) = (-s * k, c * k); // one cell left
     for i in 0..PATCH_LENGTH {
+        let f = half_l - i as f64;
         for j in 0..PATCH_WIDTH {
-            let forward = (half_l - i as f64) * PATCH_CELL;
-            let left = (half_w - j as f64) * PATCH_CELL;
-            let (px, py) = offset(x, y, yaw, forward, left);
-            h[i * PATCH_WIDTH + j] = terrain.height_at(px, py);
+            let l = half_w - j as f64;
+            let gc = gc0 + f * fx + l * lx;
+            let gr = gr0 - (f * fy + l * ly);
+            h[i * PATCH_WIDTH + j] = height_on_grid(terrain, gc, gr);
         }
     }
     let mean = h.iter().sum::<f64>() / FEATURES as f64;
@@ -206,7 +236,7 @@ pub fn collect(split: Split, cfg: &DataConfig) -> Result<SplitData, String> {
     let jobs: Vec<(usize, u32)> = (0..worlds.len())
         .flat_map(|w| (0..cfg.trials_per_map).map(move |t| (w, t)))
         .collect();
-    let runs: Vec<Result<(Vec<Sample>, f64, String), String>> = jobs
+    let runs: Vec<Result<DrivenTrial, String>> = jobs
         .par_iter()
         .map(|&(w, t)| drive_trial(&worlds[w], &sims[w], &layout, t, cfg))
         .collect();
@@ -248,6 +278,9 @@ fn wrap(a: f64) -> f64 {
     (a + std::f64::consts::PI).rem_euclid(TAU) - std::f64::consts::PI
 }
 
+/// One trial's samples, its simulated length and how it ended.
+type DrivenTrial = (Vec<Sample>, f64, String);
+
 /// One trial: its samples, its simulated length and how it ended.
 fn drive_trial(
     world: &Arc<World>,
@@ -255,7 +288,7 @@ fn drive_trial(
     layout: &WheelLayout,
     trial_no: u32,
     cfg: &DataConfig,
-) -> Result<(Vec<Sample>, f64, String), String> {
+) -> Result<DrivenTrial, String> {
     let mut rng = Rng::derive(
         cfg.seed,
         "pietra-trial",
@@ -337,6 +370,19 @@ mod tests {
             }
         }
         Heightfield::new(n, 0.5, h)
+    }
+
+    #[test]
+    fn grid_lookup_is_the_heightfield_surface() {
+        let w = crate::maps::map(crate::maps::Split::Test, 21);
+        let t = &w.terrain;
+        let mut rng = verti_core::Rng::new(1);
+        for _ in 0..1000 {
+            let (x, y) = (rng.range(-27.0, 27.0), rng.range(-27.0, 27.0));
+            let (gc, gr) = t.grid_coords(x, y);
+            let (a, b) = (height_on_grid(t, gc, gr), t.height_at(x, y));
+            assert!((a - b).abs() < 1e-9, "({x}, {y}): {a} vs {b}");
+        }
     }
 
     #[test]

@@ -97,12 +97,32 @@ impl RolloutModel for CvarRollout {
                 TravSource::Model(m) => Source::Model(m),
             };
             let region = Region::whole(&world.terrain, self.cell.max(world.terrain.cell() * 0.25));
-            self.map = Some(Arc::new(CvarMap::build(
-                &world.terrain,
-                &spec,
-                source,
-                region,
-            )));
+            let key = MapKey {
+                world: world.meta.name.clone(),
+                terrain: terrain_digest(&world.terrain),
+                model: match &self.source {
+                    TravSource::Physics => "physics prior".into(),
+                    // the weights' digests: two cards of one name are two models
+                    TravSource::Model(m) => m
+                        .networks
+                        .iter()
+                        .map(|n| n.card().weights.fnv1a64.as_str())
+                        .collect::<Vec<_>>()
+                        .join(","),
+                },
+                alpha: self.alpha.to_bits(),
+                cell: region.cell.to_bits(),
+                wheels: self
+                    .layout
+                    .wheels
+                    .as_flattened()
+                    .iter()
+                    .map(|v| v.to_bits())
+                    .collect(),
+            };
+            self.map = Some(cached_map(key, || {
+                CvarMap::build(&world.terrain, &spec, source, region)
+            }));
             self.world_name = world.meta.name.clone();
         }
     }
@@ -146,6 +166,53 @@ impl RolloutModel for CvarRollout {
             out.channel_mut(name).copy_from_slice(&c);
         }
     }
+}
+
+/// What a CVaR map depends on: its world, model, α, cell and wheels.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct MapKey {
+    world: String,
+    terrain: u64,
+    model: String,
+    alpha: u64,
+    cell: u64,
+    wheels: Vec<u64>,
+}
+
+/// A cheap fingerprint of a heightfield (two worlds of one name never share a map).
+fn terrain_digest(t: &verti_world::Heightfield) -> u64 {
+    let mut h = verti_core::rng::mix_seed(&[t.size() as u64, t.cell().to_bits()]);
+    for (i, v) in t.heights().iter().enumerate().step_by(97) {
+        h = verti_core::rng::mix_seed(&[h, i as u64, v.to_bits()]);
+    }
+    h
+}
+
+/// Maps built in this process, most recent last: every task of a world (and every trial of a
+/// benchmark) plans on the same static terrain, so its map is built once, not once per trial.
+const CACHED_MAPS: usize = 24;
+
+fn cached_map(key: MapKey, build: impl FnOnce() -> CvarMap) -> Arc<CvarMap> {
+    static CACHE: std::sync::Mutex<Vec<(MapKey, Arc<CvarMap>)>> = std::sync::Mutex::new(Vec::new());
+    if let Some((_, m)) = CACHE
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .iter()
+        .find(|(k, _)| *k == key)
+    {
+        return m.clone();
+    }
+    // built outside the lock: trials of other worlds go on meanwhile (two trials of one world
+    // may both build it; the results are identical)
+    let map = Arc::new(build());
+    let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    if !cache.iter().any(|(k, _)| *k == key) {
+        cache.push((key, map.clone()));
+        if cache.len() > CACHED_MAPS {
+            cache.remove(0);
+        }
+    }
+    map
 }
 
 /// The time-to-goal cost's weights.

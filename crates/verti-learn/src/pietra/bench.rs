@@ -116,9 +116,10 @@ pub struct Aggregate {
 impl Aggregate {
     pub fn of(errors: &SampleErrors, data: &PietraData, edges: &[f64]) -> Aggregate {
         let mut per_param = [0.0; 4];
+        let n = errors.per_param.len().max(1) as f64;
         for p in &errors.per_param {
-            for k in 0..4 {
-                per_param[k] += p[k] / errors.per_param.len().max(1) as f64;
+            for (acc, v) in per_param.iter_mut().zip(p) {
+                *acc += v / n;
             }
         }
         Aggregate {
@@ -245,7 +246,7 @@ fn same_config(a: &RunConfig, b: &RunConfig) -> bool {
 }
 
 /// The runs of `method`'s configuration with the lowest mean validation EMD².
-fn best<'a>(runs: &'a [RunScores], method: Method) -> Vec<&'a RunScores> {
+fn best(runs: &[RunScores], method: Method) -> Vec<&RunScores> {
     let mine: Vec<&RunScores> = runs.iter().filter(|r| r.config.method == method).collect();
     let mut groups: Vec<Vec<&RunScores>> = Vec::new();
     for r in mine {
@@ -281,8 +282,8 @@ fn row_of(name: &str, group: &[&RunScores], pick: fn(&RunScores) -> &Aggregate) 
     let n = aggs.len().max(1) as f64;
     let mut per_param = [0.0; 4];
     for a in &aggs {
-        for k in 0..4 {
-            per_param[k] += a.per_param[k] / n;
+        for (p, v) in per_param.iter_mut().zip(a.per_param) {
+            *p += v / n;
         }
     }
     let bins = aggs.first().map_or(0, |a| a.by_bin.len());

@@ -105,6 +105,9 @@ pub(super) fn system_registry() -> verti_bench::SystemRegistry {
     // the PPO driving policies (rl, mcl, acl)
     verti_policy::system::register(&mut r, verti_policy::shipped::systems())
         .expect("the shipped policies have distinct names and valid parameters");
+    // PIETRA's risk-aware planner over the shipped traversability model
+    verti_pietra::system::register(&mut r, verti_pietra::shipped::pietra_v1)
+        .expect("pietra has a distinct name and valid parameters");
     r
 }
 
