@@ -156,7 +156,7 @@ def test_sim_rejects_bad_input(world):
 def test_vehicles_and_systems():
     assert "hmmwv" in verti.vehicles()
     names = [s["name"] for s in verti.systems()]
-    assert names == ["pid", "eh", "mppi", "oracle", "mppi6", "wmvct", "tal", "tnt", "rl", "mcl", "acl"]
+    assert names == ["pid", "eh", "mppi", "oracle", "mppi6", "wmvct", "tal", "tnt", "rl", "mcl", "acl", "pietra"]
     pid = verti.systems()[0]
     speed = next(p for p in pid["params"] if p["name"] == "speed")
     assert speed["type"] == "float" and speed["default"] == 3.0 and speed["max"] == 30.0
@@ -213,6 +213,15 @@ def test_learned_planners_run_from_python(world):
     for name in ["tal", "tnt"]:
         r = verti.evaluate(name, [world], tasks=[1], jobs=1, max_time=2.0, params={"samples": 32})
         assert r[0]["system"] == name and r[0]["path_length"] > 0.5
+
+
+def test_pietra_runs_from_python(world):
+    # the risk-aware planner over the shipped pietra-v1; a small plan keeps the test quick
+    r = verti.evaluate("pietra", [world], tasks=[1], jobs=1, max_time=2.0, params={"samples": 64, "alpha": 0.8})
+    assert r[0]["system"] == "pietra" and r[0]["path_length"] > 0.5
+    prior = verti.evaluate("pietra", [world], tasks=[1], jobs=1, max_time=2.0,
+                           params={"samples": 64, "prior_only": True})
+    assert prior[0]["system"] == "pietra"
 
 
 def test_trained_policies_run_from_python(world):

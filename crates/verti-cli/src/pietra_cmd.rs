@@ -46,8 +46,8 @@ pub struct NavigateArgs {
     /// `pietra-v1.yaml`; the shipped one is used if absent).
     #[arg(long, default_value = "models")]
     pub models: PathBuf,
-    /// Maximum speed, m/s. The paper's robot crawled at 1 m/s; the HMMWV stalls on the test
-    /// maps' rocks at that speed (4 of 10 tasks with the physics prior, against 9 of 10 at 2
+    /// Maximum speed, m/s. The paper's robot crawled at 1 m/s; the HMMWV stalls on rock at that
+    /// speed (a first look at 10 test tasks with the physics prior: 4 reached at 1 m/s, 9 at 2
     /// m/s, the speed its data were driven at), so the default is 2.
     #[arg(long, default_value_t = 2.0)]
     pub speed: f64,

