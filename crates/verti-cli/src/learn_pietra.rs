@@ -111,9 +111,9 @@ fn grid_of(a: &PietraArgs) -> Grid {
 fn chosen(method: Method) -> (f64, f64, f64) {
     match method {
         Method::Pietra => (1e-3, 0.1, 1e-4),
-        Method::Evora => (1e-3, 0.0, 1e-5),
-        Method::Vanilla => (1e-3, 0.0, 0.0),
-        Method::Pi => (1e-3, 0.1, 0.0),
+        Method::Evora => (1e-4, 0.0, 1e-5),
+        Method::Vanilla => (1e-4, 0.0, 0.0),
+        Method::Pi => (1e-4, 0.1, 0.0),
         Method::UpiOnly => (1e-3, 0.1, 1e-5),
         Method::PpOnly => (1e-3, 0.0, 1e-5),
     }
