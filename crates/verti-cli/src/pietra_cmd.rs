@@ -263,7 +263,23 @@ fn navigate(a: &NavigateArgs) -> Result<(), String> {
             title: title.into(),
             y_label: y.into(),
             y_max: max,
-            groups: a.methods.clone(),
+            // short labels: six groups of three bars share a 360 px panel
+            groups: a
+                .methods
+                .iter()
+                .map(|m| {
+                    match m.as_str() {
+                        "pietra" => "PIETRA",
+                        "pietra-ood" => "+OOD",
+                        "evora" => "EVORA",
+                        "pi" => "PI",
+                        "vanilla" => "Vanilla",
+                        "physics" => "Prior",
+                        other => other,
+                    }
+                    .to_string()
+                })
+                .collect(),
             series: a
                 .alpha
                 .iter()
