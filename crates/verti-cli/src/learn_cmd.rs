@@ -19,9 +19,77 @@ pub enum LearnCommand {
     /// PIETRA's learning benchmark (`--benchmark`): the paper's Tables I-II and Fig. 6 on the
     /// 30 PIETRA maps, every method over its hyper-parameter grid and seeds.
     Pietra(PietraArgs),
+    /// VertiAdaptor (`va`) or one of its baselines (`node`, `mlp`, `maml`) on random-exploration
+    /// data; `--benchmark` reproduces the paper's Tables II-III and Fig. 3 on unseen worlds.
+    Va(VaArgs),
     /// Compare learning curves of `verti learn rl` runs (their `-log.csv` files), grouped by
     /// name: `none-s1-log.csv` and `none-s2-log.csv` are two seeds of group `none`.
     Curves(CurvesArgs),
+}
+
+#[derive(Args)]
+pub struct VaArgs {
+    /// va (function encoder), node (neural ODE), mlp or maml (first-order MAML).
+    #[arg(long, default_value = "va")]
+    pub method: String,
+    /// Training data (random exploration, VertiAdaptor profile, on training worlds).
+    #[arg(long, default_value = "data/random-s1")]
+    pub data: PathBuf,
+    /// Validation data (other worlds).
+    #[arg(long, default_value = "data/random-s2")]
+    pub val: PathBuf,
+    /// Basis functions k (va only; paper 24).
+    #[arg(long, default_value_t = 24)]
+    pub bases: usize,
+    /// Hidden widths of each field (paper: 313 x 4, i.e. floor(64 sqrt(k)); verti ships 64 x 4).
+    #[arg(long, value_delimiter = ',', default_value = "64,64,64,64")]
+    pub hidden: Vec<usize>,
+    /// Drop the elevation embedding (ablation).
+    #[arg(long)]
+    pub no_elevation: bool,
+    /// Drop the semantic embedding (ablation).
+    #[arg(long)]
+    pub no_semantics: bool,
+    /// Training steps (paper 1000) and Adam's learning rate, annealed to --lr-final (cosine).
+    #[arg(long, default_value_t = 1000)]
+    pub steps: usize,
+    #[arg(long, default_value_t = 1e-3)]
+    pub lr: f64,
+    #[arg(long, default_value_t = 1e-5)]
+    pub lr_final: f64,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Model card to write (default models/METHOD-v1.yaml; weights, log and curve beside it).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Validation every this many steps.
+    #[arg(long, default_value_t = 50)]
+    pub eval_every: usize,
+    /// Run the accuracy benchmark (Tables II-III, Fig. 3) instead of training: adapt every
+    /// model of --models to each test world and score it there.
+    #[arg(long)]
+    pub benchmark: bool,
+    /// Benchmark: test data (random exploration on unseen worlds, several trials per world).
+    #[arg(long, default_value = "data/va-test-s3")]
+    pub test: PathBuf,
+    /// Benchmark: LABEL=CARD pairs, comma-separated (default: va, node, maml, mlp from models/
+    /// and the three ablations from results/va-bench/models/).
+    #[arg(long, value_delimiter = ',')]
+    pub models: Vec<String>,
+    /// Benchmark: adaptation trajectories per world (the rest are scored).
+    #[arg(long, default_value_t = 4)]
+    pub examples: usize,
+    /// Benchmark: rollout length (steps of 0.1 s) and start spacing.
+    #[arg(long, default_value_t = 20)]
+    pub horizon: usize,
+    #[arg(long, default_value_t = 5)]
+    pub stride: usize,
+    /// Benchmark: multiplies the baselines' adaptation steps (1 = the paper's protocol).
+    #[arg(long, default_value_t = 1.0)]
+    pub adapt_scale: f64,
+    /// Benchmark: output folder (rows-*.jsonl, table.md, fig3-*.png).
+    #[arg(long, default_value = "results/va-bench")]
+    pub bench_out: PathBuf,
 }
 
 #[derive(Args)]
@@ -331,6 +399,7 @@ mod with_burn {
             LearnCommand::Rl(a) => crate::learn_rl::run(&a, &command_line(), &device),
             LearnCommand::Curves(a) => crate::learn_rl::curves(&a),
             LearnCommand::Pietra(a) => crate::learn_pietra::run(&a, &command_line(), &device),
+            LearnCommand::Va(a) => crate::learn_va::run(&a, &command_line(), &device),
             LearnCommand::Swae(a) => run_autoencoder(Autoencoder::Swae(a), &device),
             LearnCommand::Patch(a) => run_autoencoder(Autoencoder::Patch(a), &device),
         }

@@ -11,6 +11,8 @@ mod learn_kino;
 mod learn_pietra;
 #[cfg(feature = "learn")]
 mod learn_rl;
+#[cfg(feature = "learn")]
+mod learn_va;
 mod outputs;
 mod pietra_cmd;
 mod progress;

@@ -484,3 +484,45 @@ fn row(trial: &Trial, action: Action) -> Row {
         wheels,
     }
 }
+
+/// A drive's rows: pose, and the command (target speed, steering) held from it.
+pub type DriveRows = Vec<(verti_bench::observation::Pose6, (f64, f64))>;
+
+/// One exploration drive on `world` for a system that gathers adaptation data in its own
+/// world before a task (privileged, like the environment data of VertiAdaptor's VA*): a start
+/// and command profile drawn from `seed`, up to `max_seconds`, one row every 1/`rate` s.
+/// Returns each row's pose and the command (target speed, steering) held from it to the next.
+pub fn explore_poses(
+    world: &Arc<World>,
+    sim: Arc<Sim>,
+    profile: Profile,
+    seed: u64,
+    max_seconds: f64,
+    rate: f64,
+) -> std::result::Result<DriveRows, String> {
+    let mut rng = Rng::derive(seed, "verti-data/explore-poses", 0);
+    let start = random_start(&mut rng, world, &sim)?;
+    let commands = profile.draw(&mut rng);
+    let episode = EpisodeConfig {
+        max_time: max_seconds,
+        seed,
+        ..Default::default()
+    };
+    let mut trial = Trial::explore(world, sim, start, &episode, "explore")?;
+    let period = 1.0 / rate;
+    let edge = world.terrain.half_extent() - EDGE_MARGIN * world.meta.scale;
+    let mut out = Vec::new();
+    loop {
+        let (steering, speed) = commands.at(trial.time());
+        out.push((trial.pose(), (speed, steering)));
+        let ended = trial
+            .step(Action::HighLevel { speed, steering }, period)
+            .ended
+            .is_some();
+        let p = trial.pose();
+        if ended || p.x.abs() >= edge || p.y.abs() >= edge {
+            out.push((p, (speed, steering)));
+            return Ok(out);
+        }
+    }
+}

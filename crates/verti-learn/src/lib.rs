@@ -21,6 +21,7 @@ pub mod seq;
 pub mod swae;
 pub mod tal;
 pub mod trav;
+pub mod va;
 
 /// The device training runs on: burn's default device (the flex CPU backend here; with the
 /// `cuda` feature, `BURN_DEVICE=cuda` picks the GPU) with automatic differentiation.

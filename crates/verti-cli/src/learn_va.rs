@@ -1,0 +1,167 @@
+//! `verti learn va` (with the `learn` feature): trains VertiAdaptor or one of its baselines.
+
+use crate::learn_cmd::VaArgs;
+use crate::progress::bar;
+use std::path::PathBuf;
+use verti_learn::Device;
+use verti_learn::va::batch::Sampling;
+use verti_learn::va::bench::{self, BenchConfig};
+use verti_learn::va::command::{VaRun, learn_va};
+use verti_learn::va::net::NetSpec;
+use verti_learn::va::report;
+use verti_learn::va::train::TrainConfig;
+use verti_va::Method;
+use verti_va::lsq::LAMBDA;
+
+/// The model step (paper: RK4 over Δt = 0.1 s), full-scale seconds.
+pub const DT: f64 = 0.1;
+
+pub fn config_of(a: &VaArgs) -> Result<TrainConfig, String> {
+    let method = Method::parse(&a.method)
+        .ok_or_else(|| format!("--method {}: expected va, node, mlp or maml", a.method))?;
+    Ok(TrainConfig {
+        spec: NetSpec {
+            method,
+            bases: if method == Method::Va { a.bases } else { 1 },
+            hidden: a.hidden.clone(),
+            elevation: !a.no_elevation,
+            semantics: !a.no_semantics,
+            dt: DT,
+        },
+        sampling: Sampling::default(),
+        steps: a.steps,
+        lr: a.lr,
+        lr_final: a.lr_final,
+        lambda: LAMBDA,
+        maml_inner_lr: 0.01,
+        seed: a.seed,
+        eval_every: a.eval_every,
+    })
+}
+
+/// The models the benchmark runs by default.
+const DEFAULT_MODELS: [(&str, &str); 7] = [
+    ("va", "models/va-v1.yaml"),
+    ("node", "models/node-v1.yaml"),
+    ("maml", "models/maml-v1.yaml"),
+    ("mlp", "models/mlp-v1.yaml"),
+    (
+        "va-no-semantics",
+        "results/va-bench/models/va-no-semantics.yaml",
+    ),
+    (
+        "va-no-elevation",
+        "results/va-bench/models/va-no-elevation.yaml",
+    ),
+    ("va-no-both", "results/va-bench/models/va-no-both.yaml"),
+];
+
+fn benchmark(a: &VaArgs, device: &Device) -> Result<(), String> {
+    let models: Vec<(String, PathBuf)> = if a.models.is_empty() {
+        DEFAULT_MODELS
+            .iter()
+            .map(|(l, p)| (l.to_string(), PathBuf::from(p)))
+            .collect()
+    } else {
+        a.models
+            .iter()
+            .map(|m| {
+                m.split_once('=')
+                    .map(|(l, p)| (l.to_string(), PathBuf::from(p)))
+                    .ok_or_else(|| format!("--models {m}: expected LABEL=CARD"))
+            })
+            .collect::<Result<_, _>>()?
+    };
+    let cfg = BenchConfig {
+        test: a.test.clone(),
+        models,
+        examples: a.examples,
+        horizon: a.horizon,
+        mse_steps: 8.min(a.horizon),
+        stride: a.stride.max(1),
+        adapt_scale: a.adapt_scale,
+        out: a.bench_out.clone(),
+    };
+    let loading_bar = bar(0, "terrain latents");
+    let loading = |done: usize, total: usize| {
+        loading_bar.set_length(total as u64);
+        loading_bar.set_position(done as u64);
+    };
+    let pb = bar(0, "worlds x models");
+    let quiet = !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let mut progress = |done: usize, total: usize, label: &str| {
+        loading_bar.finish_and_clear();
+        pb.set_length(total as u64);
+        pb.set_position(done as u64);
+        pb.set_message(label.to_string());
+        if quiet {
+            eprintln!("{done}/{total} {label}");
+        }
+    };
+    bench::run(&cfg, device, &mut progress, &loading)?;
+    pb.finish_and_clear();
+    let md = report::write(&cfg.out, cfg.mse_steps)?;
+    println!("{md}");
+    println!(
+        "wrote {}/table.md, fig3-one-step.png, fig3-steps.png",
+        cfg.out.display()
+    );
+    Ok(())
+}
+
+pub fn run(a: &VaArgs, command: &str, device: &Device) -> Result<(), String> {
+    if a.benchmark {
+        return benchmark(a, device);
+    }
+    let config = config_of(a)?;
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("models/{}-v1.yaml", a.method)));
+    let run = VaRun {
+        data: a.data.clone(),
+        val: a.val.clone(),
+        out,
+        config: config.clone(),
+        command: command.to_string(),
+    };
+    let quiet = !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let loading_bar = bar(0, "terrain latents");
+    let loading = |done: usize, total: usize| {
+        loading_bar.set_length(total as u64);
+        loading_bar.set_position(done as u64);
+    };
+    let pb = bar(config.steps as u64, "training");
+    pb.set_position(0);
+    let started = std::time::Instant::now();
+    let mut progress = |step: usize, loss: f64| {
+        loading_bar.finish_and_clear();
+        pb.set_position(step as u64);
+        pb.set_message(format!("loss {loss:.4}"));
+        if quiet && (step.is_multiple_of(config.eval_every) || step == config.steps) {
+            eprintln!(
+                "step {step}/{}: loss {loss:.4} ({:.0} s)",
+                config.steps,
+                started.elapsed().as_secs_f64()
+            );
+        }
+    };
+    let trained = learn_va(&run, device, &mut progress, &loading)?;
+    pb.finish_and_clear();
+    let card = &trained.model.card;
+    if let Some(l) = trained.log.last() {
+        println!(
+            "final: train loss {:.5}, validation loss {:.5}",
+            l.train_loss, l.val_loss
+        );
+    }
+    println!(
+        "wrote {} (+ {}, {} KiB), learning curve {}; {:.0} s",
+        run.out.display(),
+        card.weights.file,
+        card.weights.floats * 4 / 1024,
+        trained.curve_png.display(),
+        trained.wall_s
+    );
+    Ok(())
+}

@@ -1,0 +1,44 @@
+//! VertiAdaptor (Xu et al.): kinodynamics as a linear combination of neural-ODE basis
+//! functions whose coefficients are identified online by least squares, in plain Rust.
+//! Training lives in `verti-learn` (`verti learn va`); everything needed to adapt, predict
+//! and plan with a trained model is here.
+//!
+//! * [`terrain`]: the elevation and semantic latents under the vehicle;
+//! * [`rk4`]: the integrator of the basis fields;
+//! * [`lsq`]: least-squares coefficients (batched normal equations, Cholesky) and recursive
+//!   least squares with forgetting;
+//! * [`model`]: the model card (VertiAdaptor and its baselines) and its evaluation;
+//! * [`data`]: trajectories of a dataset with their terrain latents, split by world.
+
+use std::path::PathBuf;
+
+pub mod adapter;
+pub mod data;
+pub mod eval;
+pub mod lsq;
+pub mod model;
+pub mod planner;
+pub mod rk4;
+pub mod system;
+pub mod terrain;
+
+pub use model::{Example, Method, VaCard, VaModel};
+
+#[derive(Debug, thiserror::Error)]
+pub enum VaError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: {field}: {why}")]
+    Card {
+        path: PathBuf,
+        field: String,
+        why: String,
+    },
+    #[error("{0}")]
+    Data(String),
+}
+
+pub type Result<T> = std::result::Result<T, VaError>;

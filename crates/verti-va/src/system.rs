@@ -1,0 +1,319 @@
+//! The `va` mobility system: MPPI over VertiAdaptor's adapted model ([`VaRollout`]) with the
+//! attitude-aware cost of verti's learned planners, and the online adaptation of
+//! [`Adapter`].
+//!
+//! `adapt=once` (VA*) adapts before the task on data from the task's world: `explore_trials`
+//! drives of `explore_seconds` with VertiAdaptor's sinusoidal exploration from random starts,
+//! driven on clones of the trial's simulator. This uses the trial privileged (as the paper's
+//! VA* uses data "sampled from the entire new environment"); every task of a world gets the
+//! same drives and so the same coefficients (computed once per process and world). The other
+//! modes use only the trial's own driving.
+
+use crate::adapter::{AdaptMode, Adapter};
+use crate::model::{EMBED, Example, VaModel};
+use crate::planner::VaRollout;
+use crate::terrain::{TERRAIN_DIM, terrain_latent};
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::{Arc, Mutex, OnceLock};
+use verti_bench::{Action, MobilitySystem, Observation, SystemInfo, TaskInfo};
+use verti_core::Factory;
+use verti_core::params::{ParamSpec, ParamValue, Params};
+use verti_core::rng::mix_seed;
+use verti_data::Profile;
+use verti_data::generate::explore_poses;
+use verti_kino::features::{Units, heading_delta};
+use verti_kino::rollout::{AttitudeCost, AttitudeWeights};
+use verti_nn::patch::PatchEncoder;
+use verti_systems::mppi::Mppi;
+use verti_systems::registry::{mppi_from, mppi_params};
+use verti_systems::rollout::PathCostWeights;
+
+/// Coefficients of `once` per (world, model, exploration), shared by the trials of a process.
+type OnceCache = Mutex<HashMap<String, Vec<f64>>>;
+
+fn once_cache() -> &'static OnceCache {
+    static CACHE: OnceLock<OnceCache> = OnceLock::new();
+    CACHE.get_or_init(|| Mutex::new(HashMap::new()))
+}
+
+/// The adaptation data of `once`: exploration drives of the trial's world.
+fn exploration_examples(
+    obs: &Observation,
+    model: &VaModel,
+    encoder: &PatchEncoder,
+    trials: usize,
+    seconds: f64,
+) -> Result<Vec<Example>, String> {
+    let trial = obs.trial().ok_or(
+        "va with adapt=once explores the task's world before the task, which needs the \
+         privileged trial (run it in verti eval, not from hand-made observations)",
+    )?;
+    let world = trial.world();
+    let scale = world.meta.scale;
+    let units = Units::new(scale);
+    let rate = 1.0 / (model.card.dt / units.time_factor());
+    let mut examples = Vec::new();
+    let mut latent = [0f32; TERRAIN_DIM];
+    for i in 0..trials {
+        let seed = mix_seed(&[u64::from(world.meta.index), i as u64, 0x7661]);
+        let drive = explore_poses(
+            world,
+            trial.sim().clone(),
+            Profile::VertiAdaptor,
+            seed,
+            seconds * scale.sqrt(),
+            rate,
+        )?;
+        for w in drive.windows(2) {
+            let (p, (v, s)) = w[0];
+            terrain_latent(world, &p, scale, encoder, &mut latent);
+            examples.push(Example {
+                roll: p.roll,
+                pitch: p.pitch,
+                embedding: model.embed(&latent),
+                command: (v / scale.sqrt(), s),
+                delta: units.delta_to_model(&heading_delta(&p, &w[1].0)),
+            });
+        }
+    }
+    Ok(examples)
+}
+
+/// MPPI with VertiAdaptor and the adaptation state it shares with the rollout model.
+pub struct VaDriver {
+    mppi: Mppi,
+    adapter: Arc<Mutex<Adapter>>,
+    encoder: PatchEncoder,
+    explore: (usize, f64),
+    last_command: (f64, f64),
+    once_done: bool,
+    failure: Option<String>,
+}
+
+impl VaDriver {
+    fn adapt_once(&mut self, obs: &Observation) -> Result<(), String> {
+        let model = self
+            .adapter
+            .lock()
+            .map_err(|e| e.to_string())?
+            .model()
+            .clone();
+        let world = obs.world();
+        let key = format!(
+            "{}#{}@{}|{}|{:?}",
+            world.meta.name,
+            world.meta.index,
+            world.meta.scale,
+            model.card.weights.fnv1a64,
+            self.explore
+        );
+        let cached = once_cache()
+            .lock()
+            .map_err(|e| e.to_string())?
+            .get(&key)
+            .cloned();
+        let alpha = match cached {
+            Some(a) => a,
+            None => {
+                let ex = exploration_examples(
+                    obs,
+                    &model,
+                    &self.encoder,
+                    self.explore.0,
+                    self.explore.1,
+                )?;
+                let a = model.adapt(&ex).map_err(|e| e.to_string())?;
+                once_cache()
+                    .lock()
+                    .map_err(|e| e.to_string())?
+                    .insert(key, a.clone());
+                a
+            }
+        };
+        self.adapter
+            .lock()
+            .map_err(|e| e.to_string())?
+            .set_alpha(alpha);
+        Ok(())
+    }
+}
+
+impl MobilitySystem for VaDriver {
+    fn name(&self) -> &str {
+        self.mppi.name()
+    }
+    fn control_rate(&self) -> f64 {
+        self.mppi.control_rate()
+    }
+    fn reset(&mut self, task: &TaskInfo) {
+        self.mppi.reset(task);
+        if let Ok(mut a) = self.adapter.lock() {
+            a.reset(task.world_scale);
+        }
+        self.last_command = (0.0, 0.0);
+        self.once_done = false;
+        self.failure = None;
+    }
+    fn act(&mut self, obs: &Observation) -> Action {
+        let mode = self
+            .adapter
+            .lock()
+            .map(|a| a.mode())
+            .unwrap_or(AdaptMode::None);
+        if mode == AdaptMode::Once && !self.once_done {
+            self.once_done = true;
+            if let Err(e) = self.adapt_once(obs) {
+                self.failure = Some(e);
+                return Action::HighLevel {
+                    speed: 0.0,
+                    steering: 0.0,
+                };
+            }
+        }
+        {
+            let encoder = &self.encoder;
+            let mut a = self
+                .adapter
+                .lock()
+                .expect("the adapter lock is never poisoned");
+            let model = a.model().clone();
+            let mut latent = [0f32; TERRAIN_DIM];
+            let mut embed = |p: &verti_bench::observation::Pose6| -> [f32; 2 * EMBED] {
+                terrain_latent(obs.world(), p, obs.world_scale, encoder, &mut latent);
+                model.embed(&latent)
+            };
+            a.observe(obs.time, obs.pose, self.last_command, &mut embed);
+        }
+        let action = self.mppi.act(obs);
+        if let Action::HighLevel { speed, steering } = action {
+            self.last_command = (speed, steering);
+        }
+        action
+    }
+    fn failure(&self) -> Option<String> {
+        self.failure.clone()
+    }
+}
+
+/// Where the system's default model comes from.
+pub type ModelSource = fn() -> Result<Arc<VaModel>, String>;
+
+/// The `va` factory.
+pub struct VaSystem {
+    pub default_model: ModelSource,
+    loaded: OnceLock<Result<Arc<VaModel>, String>>,
+}
+
+impl VaSystem {
+    pub fn new(default_model: ModelSource) -> VaSystem {
+        VaSystem {
+            default_model,
+            loaded: OnceLock::new(),
+        }
+    }
+}
+
+/// MPPI defaults for VertiAdaptor: 128 samples x 15 steps of one model step (0.1 s; 1.5 s
+/// ahead) at 10 Hz — what one CPU core affords with 24 basis fields (see the README).
+fn params() -> Vec<ParamSpec> {
+    let w = AttitudeWeights::default();
+    let mut specs: Vec<ParamSpec> = mppi_params()
+        .into_iter()
+        .filter(|s| s.name != "step")
+        .map(|mut s| {
+            match s.name.as_str() {
+                "samples" => s.default = ParamValue::Int(128),
+                "horizon" => s.default = ParamValue::Int(15),
+                "rate" => s.default = ParamValue::Float(10.0),
+                _ => {}
+            }
+            s
+        })
+        .collect();
+    specs.extend([
+        ParamSpec::float("w_attitude", w.attitude, 0.0, 1e6, "weight of predicted roll and pitch beyond 10 degrees (squared, radians)"),
+        ParamSpec::float("w_tip", w.tip, 0.0, 1e6, "cost per step with predicted roll or pitch beyond 30 degrees"),
+        ParamSpec::path("model", "", "model card (YAML) to use instead of the shipped va-small-v1 (also node, mlp or maml cards)"),
+        ParamSpec::choice("adapt", "once", &["none", "once", "every", "rls"], "coefficient adaptation: none (training prior), once (VA*: before the task, on exploration of its world; privileged), every (VA†: least squares on the last `window` s every `period` s), rls (recursive least squares with forgetting)"),
+        ParamSpec::float("period", 5.0, 0.1, 1e4, "every: seconds between solves (full scale)"),
+        ParamSpec::float("window", 5.0, 0.1, 1e4, "every: seconds of driving each solve uses (full scale)"),
+        ParamSpec::float("forgetting", 0.98, 0.5, 1.0, "rls: forgetting factor per model step (0.98: a memory of ~5 s)"),
+        ParamSpec::int("explore_trials", 4, 1, 100, "once: exploration drives of the task's world"),
+        ParamSpec::float("explore_seconds", 20.0, 1.0, 600.0, "once: length of each drive (full-scale s)"),
+    ]);
+    specs
+}
+
+impl Factory<dyn MobilitySystem> for VaSystem {
+    fn info(&self) -> SystemInfo {
+        SystemInfo {
+            name: "va".into(),
+            summary: "VertiAdaptor: MPPI over 24 neural-ODE basis functions combined by online least-squares coefficients".into(),
+            params: params(),
+        }
+    }
+
+    fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
+        let model = match p.path("model") {
+            Some(path) if path != Path::new("") => {
+                Arc::new(VaModel::load(path).map_err(|e| e.to_string())?)
+            }
+            _ => self.loaded.get_or_init(|| (self.default_model)()).clone()?,
+        };
+        let specs = mppi_params();
+        let mut pairs: Vec<(String, ParamValue)> = p
+            .to_pairs()
+            .into_iter()
+            .filter(|(n, _)| specs.iter().any(|s| &s.name == n))
+            .collect();
+        pairs.push(("step".into(), ParamValue::Float(model.card.dt)));
+        let mppi = mppi_from(&Params::resolve("va", specs, &pairs).map_err(|e| e.to_string())?);
+        let weights = AttitudeWeights {
+            path: PathCostWeights {
+                goal: mppi.w_goal,
+                obstacle: mppi.w_obstacle,
+                control: mppi.w_control,
+            },
+            attitude: p.float("w_attitude"),
+            tip: p.float("w_tip"),
+            ..AttitudeWeights::default()
+        };
+        let mode = match p.str("adapt") {
+            "none" => AdaptMode::None,
+            "once" => AdaptMode::Once,
+            "every" => AdaptMode::Every {
+                period: p.float("period"),
+                window: p.float("window"),
+            },
+            _ => AdaptMode::Rls {
+                forgetting: p.float("forgetting"),
+            },
+        };
+        if model.card.method != crate::Method::Va && mode != AdaptMode::None {
+            return Err(format!(
+                "{} is a {} card: its adaptation is gradient steps (verti learn va), so run it with adapt=none",
+                model.card.name,
+                model.card.method.name()
+            ));
+        }
+        let encoder = verti_nn::shipped::patch_v1()?;
+        let adapter = Arc::new(Mutex::new(Adapter::new(model, mode)));
+        let rollout = VaRollout::new(adapter.clone(), encoder.clone());
+        let mppi = Mppi::with_model(
+            "va",
+            mppi,
+            Box::new(rollout),
+            Box::new(AttitudeCost::new(weights)),
+        );
+        Ok(Box::new(VaDriver {
+            mppi,
+            adapter,
+            encoder,
+            explore: (p.usize("explore_trials"), p.float("explore_seconds")),
+            last_command: (0.0, 0.0),
+            once_done: false,
+            failure: None,
+        }))
+    }
+}
