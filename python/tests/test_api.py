@@ -156,7 +156,7 @@ def test_sim_rejects_bad_input(world):
 def test_vehicles_and_systems():
     assert "hmmwv" in verti.vehicles()
     names = [s["name"] for s in verti.systems()]
-    assert names == ["pid", "eh", "mppi", "oracle", "mppi6", "wmvct", "tal", "tnt", "rl", "mcl", "acl", "pietra"]
+    assert names == ["pid", "eh", "mppi", "oracle", "mppi6", "wmvct", "tal", "tnt", "rl", "mcl", "acl", "pietra", "va"]
     pid = verti.systems()[0]
     speed = next(p for p in pid["params"] if p["name"] == "speed")
     assert speed["type"] == "float" and speed["default"] == 3.0 and speed["max"] == 30.0
@@ -222,6 +222,15 @@ def test_pietra_runs_from_python(world):
     prior = verti.evaluate("pietra", [world], tasks=[1], jobs=1, max_time=2.0,
                            params={"samples": 64, "prior_only": True})
     assert prior[0]["system"] == "pietra"
+
+
+def test_va_runs_from_python(world):
+    # VertiAdaptor over the shipped va-small-v1, adapting online (recursive least squares) and
+    # once on exploration of the world (privileged: verti.evaluate runs a real trial)
+    for adapt in ["rls", "once"]:
+        r = verti.evaluate("va", [world], tasks=[1], jobs=1, max_time=2.0,
+                           params={"samples": 16, "adapt": adapt, "explore_trials": 1, "explore_seconds": 2.0})
+        assert r[0]["system"] == "va" and r[0]["error"] is None and r[0]["path_length"] > 0.2
 
 
 def test_trained_policies_run_from_python(world):

@@ -90,6 +90,23 @@ pub struct VaArgs {
     /// Benchmark: output folder (rows-*.jsonl, table.md, fig3-*.png).
     #[arg(long, default_value = "results/va-bench")]
     pub bench_out: PathBuf,
+    /// Adapt --adapt-model once to each world of this set (navigation's MAML*: the same
+    /// exploration drives as `va adapt=once`), writing DIR/wNNN.yaml for `--param model=DIR/w{world}.yaml`.
+    #[arg(long)]
+    pub adapt_to: Option<String>,
+    /// World indices of --adapt-to (e.g. 1,2,4), default all.
+    #[arg(long, value_delimiter = ',')]
+    pub adapt_worlds: Vec<u32>,
+    #[arg(long, default_value = "models/maml-v1.yaml")]
+    pub adapt_model: PathBuf,
+    #[arg(long, default_value = "results/va-nav/maml")]
+    pub adapt_out: PathBuf,
+    /// Exploration drives per world and their length (s), as `va`'s explore_trials and
+    /// explore_seconds.
+    #[arg(long, default_value_t = 4)]
+    pub explore_trials: usize,
+    #[arg(long, default_value_t = 20.0)]
+    pub explore_seconds: f64,
 }
 
 #[derive(Args)]

@@ -109,9 +109,66 @@ fn benchmark(a: &VaArgs, device: &Device) -> Result<(), String> {
     Ok(())
 }
 
+/// `--adapt-to`: one adapted card per world.
+fn adapt_to_worlds(a: &VaArgs, set: &str, device: &Device) -> Result<(), String> {
+    let model = verti_va::VaModel::load(&a.adapt_model).map_err(|e| e.to_string())?;
+    let resolved = verti_world::sets::resolve_set(set, 1.0, &|| {}).map_err(|e| e.to_string())?;
+    let worlds: Vec<_> = resolved
+        .worlds
+        .into_iter()
+        .filter(|w| a.adapt_worlds.is_empty() || a.adapt_worlds.contains(&w.meta.index))
+        .map(std::sync::Arc::new)
+        .collect();
+    if worlds.is_empty() {
+        return Err(format!("{set} has none of the worlds {:?}", a.adapt_worlds));
+    }
+    let spec = verti_sim::vehicles::builtin(&model.card.vehicle).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(&a.adapt_out).map_err(|e| format!("{}: {e}", a.adapt_out.display()))?;
+    let pb = bar(worlds.len() as u64, "adapting");
+    for w in &worlds {
+        let name = format!("w{:03}", w.meta.index);
+        let started = std::time::Instant::now();
+        let sim = verti_sim::Sim::new(w, &spec).map_err(|e| format!("{}: {e}", w.meta.name))?;
+        let mut adapted = verti_learn::va::adapt::adapt_to_world(
+            &model,
+            w,
+            std::sync::Arc::new(sim),
+            a.explore_trials,
+            a.explore_seconds,
+            a.adapt_scale,
+            &name,
+            device,
+        )?;
+        adapted
+            .card
+            .metrics
+            .insert("adapt_s".into(), started.elapsed().as_secs_f64());
+        adapted
+            .save(&a.adapt_out.join(format!("{name}.yaml")))
+            .map_err(|e| e.to_string())?;
+        pb.inc(1);
+        pb.println(format!(
+            "{}: adapted in {:.1} s",
+            w.meta.name,
+            started.elapsed().as_secs_f64()
+        ));
+    }
+    pb.finish_and_clear();
+    println!(
+        "wrote {} cards to {} (use --param model={}/w{{world}}.yaml --param adapt=none)",
+        worlds.len(),
+        a.adapt_out.display(),
+        a.adapt_out.display()
+    );
+    Ok(())
+}
+
 pub fn run(a: &VaArgs, command: &str, device: &Device) -> Result<(), String> {
     if a.benchmark {
         return benchmark(a, device);
+    }
+    if let Some(set) = &a.adapt_to {
+        return adapt_to_worlds(a, set, device);
     }
     let config = config_of(a)?;
     let out = a

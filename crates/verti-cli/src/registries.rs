@@ -18,6 +18,9 @@ pub fn systems() -> SystemRegistry {
     // PIETRA's risk-aware planner over the shipped traversability model, evaluated without burn
     verti_pietra::system::register(&mut r, verti_pietra::shipped::pietra_v1)
         .expect("system names are unique");
+    // VertiAdaptor: MPPI over the shipped function encoder with online least squares
+    verti_va::system::register(&mut r, verti_va::shipped::va_small_v1)
+        .expect("system names are unique");
     r
 }
 

@@ -15,10 +15,12 @@ use std::path::PathBuf;
 pub mod adapter;
 pub mod data;
 pub mod eval;
+pub mod explore;
 pub mod lsq;
 pub mod model;
 pub mod planner;
 pub mod rk4;
+pub mod shipped;
 pub mod system;
 pub mod terrain;
 

@@ -403,21 +403,66 @@ impl VaModel {
         out
     }
 
-    /// Field `i` at attitude (roll, pitch): the pose rates.
-    fn field(
+    /// Field `i`'s first-layer sums without roll and pitch: b₁ + W₁[2..]ᵀ·rest. The rest of
+    /// the input (embeddings, command) is held through the RK4 stages, so this part is
+    /// computed once per step instead of once per stage.
+    fn field_base(&self, i: usize, rest: &[f32; FIELD_INPUT - 2], base: &mut Vec<f32>) {
+        let l = &self.fields[0];
+        let o_n = l.outputs;
+        let w = &l.w[i * l.inputs * o_n..(i + 1) * l.inputs * o_n];
+        base.clear();
+        base.extend_from_slice(&l.b[i * o_n..(i + 1) * o_n]);
+        for (j, &x) in rest.iter().enumerate() {
+            if x != 0.0 {
+                for (o, wv) in base.iter_mut().zip(&w[(j + 2) * o_n..(j + 3) * o_n]) {
+                    *o += x * wv;
+                }
+            }
+        }
+    }
+
+    /// Field `i` at attitude (roll, pitch) from its [`VaModel::field_base`]: the pose rates.
+    fn field_from_base(
         &self,
         i: usize,
+        base: &[f32],
         roll: f64,
         pitch: f64,
-        rest: &[f32; FIELD_INPUT - 2],
-        buf: &mut [Vec<f32>; 2],
+        scratch: &mut [Vec<f32>; 2],
     ) -> [f64; POSE_DIM] {
-        let mut x = [0f32; FIELD_INPUT];
-        x[0] = roll as f32;
-        x[1] = pitch as f32;
-        x[2..].copy_from_slice(rest);
-        let y = dense_forward(&self.fields, i, &x, buf);
-        std::array::from_fn(|d| f64::from(y[d]))
+        let l0 = &self.fields[0];
+        let o_n = l0.outputs;
+        let w = &l0.w[i * l0.inputs * o_n..];
+        let (r, p) = (roll as f32, pitch as f32);
+        let [a, b] = scratch;
+        a.clear();
+        a.extend(
+            base.iter()
+                .zip(&w[..o_n])
+                .zip(&w[o_n..2 * o_n])
+                .map(|((c, wr), wp)| c + r * wr + p * wp),
+        );
+        let layers = self.fields.len();
+        for (l, layer) in self.fields.iter().enumerate().skip(1) {
+            // the previous layer was hidden: ReLU
+            for v in a.iter_mut() {
+                *v = v.max(0.0);
+            }
+            let (i_n, o_n) = (layer.inputs, layer.outputs);
+            let w = &layer.w[i * i_n * o_n..(i + 1) * i_n * o_n];
+            b.clear();
+            b.extend_from_slice(&layer.b[i * o_n..(i + 1) * o_n]);
+            for (j, &x) in a.iter().enumerate() {
+                if x != 0.0 {
+                    for (o, wv) in b.iter_mut().zip(&w[j * o_n..(j + 1) * o_n]) {
+                        *o += x * wv;
+                    }
+                }
+            }
+            std::mem::swap(a, b);
+            debug_assert!(l < layers);
+        }
+        std::array::from_fn(|d| f64::from(a[d]))
     }
 
     /// Every basis function's change G_i over one step, k × 6 row-major into `out`: RK4 of
@@ -434,14 +479,26 @@ impl VaModel {
         rest[..2 * EMBED].copy_from_slice(embedding);
         rest[2 * EMBED] = command.0 as f32;
         rest[2 * EMBED + 1] = command.1 as f32;
-        let mut buf = [Vec::with_capacity(64), Vec::with_capacity(64)];
+        let width = self
+            .card
+            .hidden
+            .iter()
+            .copied()
+            .max()
+            .unwrap_or(POSE_DIM)
+            .max(POSE_DIM);
+        let mut base = Vec::with_capacity(width);
+        let mut scratch = [Vec::with_capacity(width), Vec::with_capacity(width)];
         let dt = self.card.dt;
         for i in 0..self.card.bases {
+            self.field_base(i, &rest, &mut base);
             let g = if self.card.method.integrates() {
                 let start = [0.0, 0.0, 0.0, 0.0, roll, pitch];
-                rk4_delta(&start, dt, |s| self.field(i, s[4], s[5], &rest, &mut buf))
+                rk4_delta(&start, dt, |s| {
+                    self.field_from_base(i, &base, s[4], s[5], &mut scratch)
+                })
             } else {
-                self.field(i, roll, pitch, &rest, &mut buf)
+                self.field_from_base(i, &base, roll, pitch, &mut scratch)
             };
             out[i * POSE_DIM..(i + 1) * POSE_DIM].copy_from_slice(&g);
         }

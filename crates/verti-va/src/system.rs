@@ -10,6 +10,7 @@
 //! modes use only the trial's own driving.
 
 use crate::adapter::{AdaptMode, Adapter};
+use crate::explore::{drives_to_examples, explore_world};
 use crate::model::{EMBED, Example, VaModel};
 use crate::planner::VaRollout;
 use crate::terrain::{TERRAIN_DIM, terrain_latent};
@@ -19,10 +20,6 @@ use std::sync::{Arc, Mutex, OnceLock};
 use verti_bench::{Action, MobilitySystem, Observation, SystemInfo, TaskInfo};
 use verti_core::Factory;
 use verti_core::params::{ParamSpec, ParamValue, Params};
-use verti_core::rng::mix_seed;
-use verti_data::Profile;
-use verti_data::generate::explore_poses;
-use verti_kino::features::{Units, heading_delta};
 use verti_kino::rollout::{AttitudeCost, AttitudeWeights};
 use verti_nn::patch::PatchEncoder;
 use verti_systems::mppi::Mppi;
@@ -49,35 +46,14 @@ fn exploration_examples(
         "va with adapt=once explores the task's world before the task, which needs the \
          privileged trial (run it in verti eval, not from hand-made observations)",
     )?;
-    let world = trial.world();
-    let scale = world.meta.scale;
-    let units = Units::new(scale);
-    let rate = 1.0 / (model.card.dt / units.time_factor());
-    let mut examples = Vec::new();
-    let mut latent = [0f32; TERRAIN_DIM];
-    for i in 0..trials {
-        let seed = mix_seed(&[u64::from(world.meta.index), i as u64, 0x7661]);
-        let drive = explore_poses(
-            world,
-            trial.sim().clone(),
-            Profile::VertiAdaptor,
-            seed,
-            seconds * scale.sqrt(),
-            rate,
-        )?;
-        for w in drive.windows(2) {
-            let (p, (v, s)) = w[0];
-            terrain_latent(world, &p, scale, encoder, &mut latent);
-            examples.push(Example {
-                roll: p.roll,
-                pitch: p.pitch,
-                embedding: model.embed(&latent),
-                command: (v / scale.sqrt(), s),
-                delta: units.delta_to_model(&heading_delta(&p, &w[1].0)),
-            });
-        }
-    }
-    Ok(examples)
+    let drives = explore_world(
+        trial.world(),
+        trial.sim().clone(),
+        model.card.dt,
+        trials,
+        seconds,
+    )?;
+    Ok(drives_to_examples(&drives, trial.world(), model, encoder))
 }
 
 /// MPPI with VertiAdaptor and the adaptation state it shares with the rollout model.
@@ -89,6 +65,27 @@ pub struct VaDriver {
     last_command: (f64, f64),
     once_done: bool,
     failure: Option<String>,
+    /// A model path with `{world}` in it: the card of each task's world, loaded at reset.
+    per_world: Option<String>,
+    /// MPPI plans at every `plan_every`-th control step (the adapter sees every one).
+    plan_every: usize,
+    acts: usize,
+    held: Action,
+}
+
+/// Models loaded for `{world}` paths, shared by the trials of a process.
+fn per_world_model(path: &str) -> Result<Arc<VaModel>, String> {
+    static CACHE: OnceLock<Mutex<HashMap<String, Arc<VaModel>>>> = OnceLock::new();
+    let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
+    if let Some(m) = cache.lock().map_err(|e| e.to_string())?.get(path) {
+        return Ok(m.clone());
+    }
+    let m = Arc::new(VaModel::load(Path::new(path)).map_err(|e| e.to_string())?);
+    cache
+        .lock()
+        .map_err(|e| e.to_string())?
+        .insert(path.to_string(), m.clone());
+    Ok(m)
 }
 
 impl VaDriver {
@@ -148,14 +145,36 @@ impl MobilitySystem for VaDriver {
     }
     fn reset(&mut self, task: &TaskInfo) {
         self.mppi.reset(task);
-        if let Ok(mut a) = self.adapter.lock() {
-            a.reset(task.world_scale);
-        }
         self.last_command = (0.0, 0.0);
         self.once_done = false;
         self.failure = None;
+        self.acts = 0;
+        if let Ok(mut a) = self.adapter.lock() {
+            if let Some(pattern) = &self.per_world {
+                let path = pattern.replace("{world}", &format!("{:03}", task.id.world));
+                match per_world_model(&path) {
+                    Ok(m) if m.card.method != crate::Method::Va && a.mode() != AdaptMode::None => {
+                        self.failure = Some(format!(
+                            "{path} is a {} card: run it with adapt=none",
+                            m.card.method.name()
+                        ))
+                    }
+                    Ok(m) => *a = Adapter::new(m, a.mode()),
+                    Err(e) => {
+                        self.failure = Some(format!("model for world {}: {e}", task.id.world))
+                    }
+                }
+            }
+            a.reset(task.world_scale);
+        }
     }
     fn act(&mut self, obs: &Observation) -> Action {
+        if self.failure.is_some() {
+            return Action::HighLevel {
+                speed: 0.0,
+                steering: 0.0,
+            };
+        }
         let mode = self
             .adapter
             .lock()
@@ -185,11 +204,14 @@ impl MobilitySystem for VaDriver {
             };
             a.observe(obs.time, obs.pose, self.last_command, &mut embed);
         }
-        let action = self.mppi.act(obs);
-        if let Action::HighLevel { speed, steering } = action {
+        if self.acts.is_multiple_of(self.plan_every) {
+            self.held = self.mppi.act(obs);
+        }
+        self.acts += 1;
+        if let Action::HighLevel { speed, steering } = self.held {
             self.last_command = (speed, steering);
         }
-        action
+        self.held
     }
     fn failure(&self) -> Option<String> {
         self.failure.clone()
@@ -215,7 +237,9 @@ impl VaSystem {
 }
 
 /// MPPI defaults for VertiAdaptor: 128 samples x 15 steps of one model step (0.1 s; 1.5 s
-/// ahead) at 10 Hz — what one CPU core affords with 24 basis fields (see the README).
+/// ahead), planned at 5 Hz within a 10 Hz control loop — what one CPU core affords with 24
+/// basis fields (see the README). The control rate must be one per model step (10 Hz at full
+/// scale, 10/√s Hz on a world of scale s) for `every` and `rls` to see examples.
 fn params() -> Vec<ParamSpec> {
     let w = AttitudeWeights::default();
     let mut specs: Vec<ParamSpec> = mppi_params()
@@ -234,11 +258,12 @@ fn params() -> Vec<ParamSpec> {
     specs.extend([
         ParamSpec::float("w_attitude", w.attitude, 0.0, 1e6, "weight of predicted roll and pitch beyond 10 degrees (squared, radians)"),
         ParamSpec::float("w_tip", w.tip, 0.0, 1e6, "cost per step with predicted roll or pitch beyond 30 degrees"),
-        ParamSpec::path("model", "", "model card (YAML) to use instead of the shipped va-small-v1 (also node, mlp or maml cards)"),
+        ParamSpec::path("model", "", "model card (YAML) to use instead of the shipped va-small-v1 (also node, mlp or maml cards); {world} in the path is replaced by each task's world index (001, 002, ...): cards adapted per world"),
         ParamSpec::choice("adapt", "once", &["none", "once", "every", "rls"], "coefficient adaptation: none (training prior), once (VA*: before the task, on exploration of its world; privileged), every (VA†: least squares on the last `window` s every `period` s), rls (recursive least squares with forgetting)"),
         ParamSpec::float("period", 5.0, 0.1, 1e4, "every: seconds between solves (full scale)"),
         ParamSpec::float("window", 5.0, 0.1, 1e4, "every: seconds of driving each solve uses (full scale)"),
         ParamSpec::float("forgetting", 0.98, 0.5, 1.0, "rls: forgetting factor per model step (0.98: a memory of ~5 s)"),
+        ParamSpec::int("plan_every", 2, 1, 100, "plan at every n-th control step (10 Hz control, 5 Hz planning by default); the adapter sees every step"),
         ParamSpec::int("explore_trials", 4, 1, 100, "once: exploration drives of the task's world"),
         ParamSpec::float("explore_seconds", 20.0, 1.0, 600.0, "once: length of each drive (full-scale s)"),
     ]);
@@ -255,10 +280,13 @@ impl Factory<dyn MobilitySystem> for VaSystem {
     }
 
     fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
-        let model = match p.path("model") {
-            Some(path) if path != Path::new("") => {
-                Arc::new(VaModel::load(path).map_err(|e| e.to_string())?)
-            }
+        let given = p.path("model").filter(|path| *path != Path::new(""));
+        let per_world = given
+            .map(|path| path.to_string_lossy().to_string())
+            .filter(|path| path.contains("{world}"));
+        let model = match (given, &per_world) {
+            (Some(path), None) => Arc::new(VaModel::load(path).map_err(|e| e.to_string())?),
+            // with {world}, the shipped model stands in until a reset loads the task's own card
             _ => self.loaded.get_or_init(|| (self.default_model)()).clone()?,
         };
         let specs = mppi_params();
@@ -290,7 +318,8 @@ impl Factory<dyn MobilitySystem> for VaSystem {
                 forgetting: p.float("forgetting"),
             },
         };
-        if model.card.method != crate::Method::Va && mode != AdaptMode::None {
+        if per_world.is_none() && model.card.method != crate::Method::Va && mode != AdaptMode::None
+        {
             return Err(format!(
                 "{} is a {} card: its adaptation is gradient steps (verti learn va), so run it with adapt=none",
                 model.card.name,
@@ -314,6 +343,21 @@ impl Factory<dyn MobilitySystem> for VaSystem {
             last_command: (0.0, 0.0),
             once_done: false,
             failure: None,
+            per_world,
+            plan_every: p.usize("plan_every"),
+            acts: 0,
+            held: Action::HighLevel {
+                speed: 0.0,
+                steering: 0.0,
+            },
         }))
     }
+}
+
+/// Registers `va` with its default model.
+pub fn register(
+    registry: &mut verti_bench::SystemRegistry,
+    default_model: ModelSource,
+) -> Result<(), verti_core::params::ParamError> {
+    registry.register(VaSystem::new(default_model))
 }

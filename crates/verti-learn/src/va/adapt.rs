@@ -124,3 +124,46 @@ pub fn adapt_gradient(
     )
     .map_err(|e| e.to_string())
 }
+
+/// `model` adapted to `world` on the exploration drives every "once per environment" method
+/// sees ([`verti_va::explore`]): the baselines' gradient protocol (steps × `scale`), or
+/// VertiAdaptor's least-squares solve written into the card's prior coefficients. The card is
+/// renamed `name` (weights `name.bin`).
+#[allow(clippy::too_many_arguments)]
+pub fn adapt_to_world(
+    model: &VaModel,
+    world: &std::sync::Arc<verti_world::World>,
+    sim: std::sync::Arc<verti_sim::Sim>,
+    trials: usize,
+    seconds: f64,
+    scale: f64,
+    name: &str,
+    device: &Device,
+) -> Result<VaModel, String> {
+    let drives = verti_va::explore::explore_world(world, sim, model.card.dt, trials, seconds)?;
+    let encoder = verti_nn::shipped::patch_v1()?;
+    let mut adapted = match Protocol::of(model.card.method, scale) {
+        None => {
+            let ex = verti_va::explore::drives_to_examples(&drives, world, model, &encoder);
+            let mut m = model.clone();
+            m.card.alpha_prior = model.adapt(&ex).map_err(|e| e.to_string())?;
+            m
+        }
+        Some(p) => {
+            let mut points = Points::default();
+            for (latent, roll, pitch, command, delta) in
+                verti_va::explore::drives_to_rows(&drives, world, &encoder)
+            {
+                points.push_raw(&latent, roll, pitch, command, &delta);
+            }
+            adapt_gradient(model, &points, p, device)?
+        }
+    };
+    adapted.card.name = name.to_string();
+    adapted.card.weights.file = format!("{name}.bin");
+    adapted.card.summary = format!(
+        "{} adapted to world {} ({} exploration drives of {seconds} s)",
+        model.card.name, world.meta.name, trials
+    );
+    Ok(adapted)
+}

@@ -46,6 +46,20 @@ impl Points {
         self.delta
             .extend(traj.delta(t, data.units).map(|x| x as f32));
     }
+    /// Adds one example from raw values (terrain latent, attitude, full-scale command and change).
+    pub fn push_raw(
+        &mut self,
+        terrain: &[f32],
+        roll: f64,
+        pitch: f64,
+        command: (f64, f64),
+        delta: &[f64; POSE_DIM],
+    ) {
+        self.terrain.extend_from_slice(terrain);
+        self.roll_pitch.extend([roll as f32, pitch as f32]);
+        self.command.extend([command.0 as f32, command.1 as f32]);
+        self.delta.extend(delta.map(|x| x as f32));
+    }
     pub fn extend(&mut self, other: &Points) {
         self.terrain.extend(&other.terrain);
         self.roll_pitch.extend(&other.roll_pitch);

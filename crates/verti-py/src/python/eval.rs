@@ -108,6 +108,9 @@ pub(super) fn system_registry() -> verti_bench::SystemRegistry {
     // PIETRA's risk-aware planner over the shipped traversability model
     verti_pietra::system::register(&mut r, verti_pietra::shipped::pietra_v1)
         .expect("pietra has a distinct name and valid parameters");
+    // VertiAdaptor over the shipped function encoder
+    verti_va::system::register(&mut r, verti_va::shipped::va_small_v1)
+        .expect("va has a distinct name and valid parameters");
     r
 }
 

@@ -1,0 +1,31 @@
+//! The model the `va` system plans with by default (`va-small-v1`: 24 basis fields of
+//! [32, 32]), compiled in so a fresh clone plans without training (`verti learn va --hidden
+//! 32,32 --out models/va-small-v1.yaml` reproduces it).
+
+use crate::model::{VaModel, parse_card};
+use std::path::Path;
+use std::sync::Arc;
+
+const CARD: &str = include_str!("../../../models/va-small-v1.yaml");
+const WEIGHTS: &[u8] = include_bytes!("../../../models/va-small-v1.bin");
+
+/// The shipped `va-small-v1`.
+pub fn va_small_v1() -> Result<Arc<VaModel>, String> {
+    let origin = Path::new("models/va-small-v1.yaml");
+    let card = parse_card(CARD, origin).map_err(|e| e.to_string())?;
+    VaModel::from_bytes(card, WEIGHTS, origin)
+        .map(Arc::new)
+        .map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_shipped_model_loads_and_predicts_forward_motion() {
+        let m = super::va_small_v1().unwrap();
+        assert_eq!(m.card.bases, 24);
+        // 2 m/s straight ahead on flat, rigid ground: the vehicle moves forward
+        let d = m.predict(&m.card.alpha_prior, 0.0, 0.0, &[0.0; 16], (2.0, 0.0));
+        assert!(d[0] > 0.05 && d[0] < 0.4, "{d:?}");
+    }
+}
