@@ -91,7 +91,7 @@ pub struct VaArgs {
     #[arg(long, default_value = "results/va-bench")]
     pub bench_out: PathBuf,
     /// Adapt --adapt-model once to each world of this set (navigation's MAML*: the same
-    /// exploration drives as `va adapt=once`), writing DIR/wNNN.yaml for `--param model=DIR/w{world}.yaml`.
+    /// exploration drives as `va adapt=once`), writing DIR/wNNN.yaml for `--param model_per_world=DIR/w{world}.yaml`.
     #[arg(long)]
     pub adapt_to: Option<String>,
     /// World indices of --adapt-to (e.g. 1,2,4), default all.

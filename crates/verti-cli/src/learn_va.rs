@@ -80,6 +80,7 @@ fn benchmark(a: &VaArgs, device: &Device) -> Result<(), String> {
         mse_steps: 8.min(a.horizon),
         stride: a.stride.max(1),
         adapt_scale: a.adapt_scale,
+        online: true,
         out: a.bench_out.clone(),
     };
     let loading_bar = bar(0, "terrain latents");
@@ -147,15 +148,21 @@ fn adapt_to_worlds(a: &VaArgs, set: &str, device: &Device) -> Result<(), String>
             .save(&a.adapt_out.join(format!("{name}.yaml")))
             .map_err(|e| e.to_string())?;
         pb.inc(1);
-        pb.println(format!(
+        // the bar hides itself without a terminal (logs): say it on stderr then
+        let line = format!(
             "{}: adapted in {:.1} s",
             w.meta.name,
             started.elapsed().as_secs_f64()
-        ));
+        );
+        if pb.is_hidden() {
+            eprintln!("{line}");
+        } else {
+            pb.println(line);
+        }
     }
     pb.finish_and_clear();
     println!(
-        "wrote {} cards to {} (use --param model={}/w{{world}}.yaml --param adapt=none)",
+        "wrote {} cards to {} (use --param model_per_world={}/w{{world}}.yaml --param adapt=none)",
         worlds.len(),
         a.adapt_out.display(),
         a.adapt_out.display()

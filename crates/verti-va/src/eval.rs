@@ -167,3 +167,94 @@ pub fn errors(
     }
     total
 }
+
+/// Errors of `model` adapting online while it drives `trajectories` (one world's, in order):
+/// before each step the model predicts with its current coefficients (one step, and a
+/// rollout every `stride` steps), then the [`Adapter`] takes in the step, as the `va` system
+/// does. The adapter carries over from one trajectory to the next (the same world), but no
+/// example spans two. `mode` `once`/`none` keep the coefficients they start with, `alpha0`.
+pub fn online_errors(
+    model: &std::sync::Arc<VaModel>,
+    mode: crate::adapter::AdaptMode,
+    alpha0: &[f64],
+    data: &VaData,
+    trajectories: &[usize],
+    horizon: usize,
+    stride: usize,
+) -> ErrorSums {
+    use crate::adapter::Adapter;
+    let mut adapter = Adapter::new(model.clone(), mode);
+    adapter.reset(data.units.scale);
+    adapter.set_alpha(alpha0.to_vec());
+    let dt_world = adapter.dt_world();
+    let mut sums = ErrorSums::new(horizon);
+    let mut clock = 0.0;
+    for &i in trajectories {
+        let traj = &data.trajectories[i];
+        let n = traj.len();
+        let embeddings: Vec<[f32; 2 * EMBED]> =
+            (0..n).map(|t| model.embed(traj.terrain_at(t))).collect();
+        for s in 0..n {
+            let alpha = adapter.alpha().to_vec();
+            let predict = |t: usize, roll: f64, pitch: f64| {
+                model.predict(&alpha, roll, pitch, &embeddings[t], traj.commands[t])
+            };
+            if s + 1 < n {
+                let p = &traj.poses[s];
+                let d = predict(s, p.roll, p.pitch);
+                let truth = traj.delta(s, data.units);
+                for k in 0..POSE_DIM {
+                    let e = d[k] - truth[k];
+                    sums.one_step_abs[k] += e.abs();
+                    sums.one_step_sq[k] += e * e;
+                }
+                sums.one_step_count += 1;
+            }
+            if s % stride == 0 && s + horizon < n {
+                let p0 = &traj.poses[s];
+                let mut st = [0.0; POSE_DIM];
+                for t in 0..horizon {
+                    let d = predict(s + t, p0.roll + st[4], p0.pitch + st[5]);
+                    let (sn, cs) = st[3].sin_cos();
+                    st[0] += cs * d[0] - sn * d[1];
+                    st[1] += sn * d[0] + cs * d[1];
+                    st[2] += d[2];
+                    st[3] = wrap_angle(st[3] + d[3]);
+                    st[4] += d[4];
+                    st[5] += d[5];
+                    let truth = data
+                        .units
+                        .delta_to_model(&heading_delta(p0, &traj.poses[s + t + 1]));
+                    let mut e = [0.0; POSE_DIM];
+                    for k in 0..POSE_DIM {
+                        e[k] = if k == 3 {
+                            wrap_angle(st[k] - truth[k])
+                        } else {
+                            st[k] - truth[k]
+                        };
+                        sums.step_sq[t][k] += e[k] * e[k];
+                    }
+                    let pos = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+                    let ang = (e[3] * e[3] + e[4] * e[4] + e[5] * e[5]).sqrt();
+                    sums.step_pos[t][0] += pos;
+                    sums.step_pos[t][1] += pos * pos;
+                    sums.step_ang[t][0] += ang;
+                    sums.step_ang[t][1] += ang * ang;
+                }
+                sums.rollouts += 1;
+            }
+            // the command is in model units; the adapter takes world units
+            let (v, steer) = traj.commands[s];
+            let e = embeddings[s];
+            adapter.observe(
+                clock + s as f64 * dt_world,
+                traj.poses[s],
+                (v * data.units.scale.sqrt(), steer),
+                &mut |_| e,
+            );
+        }
+        // a gap between trajectories: no example joins two trials
+        clock += (n as f64 + 10.0) * dt_world;
+    }
+    sums
+}

@@ -71,11 +71,7 @@ pub fn drives_to_examples(
 pub type RawStep = ([f32; TERRAIN_DIM], f64, f64, (f64, f64), [f64; 6]);
 
 /// The raw inputs of each step for training code that embeds with its own networks.
-pub fn drives_to_rows(
-    drives: &[DriveRows],
-    world: &World,
-    encoder: &PatchEncoder,
-) -> Vec<RawStep> {
+pub fn drives_to_rows(drives: &[DriveRows], world: &World, encoder: &PatchEncoder) -> Vec<RawStep> {
     let scale = world.meta.scale;
     let units = Units::new(scale);
     let mut out = Vec::new();

@@ -258,7 +258,8 @@ fn params() -> Vec<ParamSpec> {
     specs.extend([
         ParamSpec::float("w_attitude", w.attitude, 0.0, 1e6, "weight of predicted roll and pitch beyond 10 degrees (squared, radians)"),
         ParamSpec::float("w_tip", w.tip, 0.0, 1e6, "cost per step with predicted roll or pitch beyond 30 degrees"),
-        ParamSpec::path("model", "", "model card (YAML) to use instead of the shipped va-small-v1 (also node, mlp or maml cards); {world} in the path is replaced by each task's world index (001, 002, ...): cards adapted per world"),
+        ParamSpec::path("model", "", "model card (YAML) to use instead of the shipped va-small-v1 (also node, mlp or maml cards)"),
+        ParamSpec::string("model_per_world", "", "a card path with {world} in it, replaced by each task's world index (001, 002, ...): cards adapted to each world (verti learn va --adapt-to); overrides model"),
         ParamSpec::choice("adapt", "once", &["none", "once", "every", "rls"], "coefficient adaptation: none (training prior), once (VA*: before the task, on exploration of its world; privileged), every (VA†: least squares on the last `window` s every `period` s), rls (recursive least squares with forgetting)"),
         ParamSpec::float("period", 5.0, 0.1, 1e4, "every: seconds between solves (full scale)"),
         ParamSpec::float("window", 5.0, 0.1, 1e4, "every: seconds of driving each solve uses (full scale)"),
@@ -281,9 +282,14 @@ impl Factory<dyn MobilitySystem> for VaSystem {
 
     fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
         let given = p.path("model").filter(|path| *path != Path::new(""));
-        let per_world = given
-            .map(|path| path.to_string_lossy().to_string())
-            .filter(|path| path.contains("{world}"));
+        let per_world = Some(p.str("model_per_world").to_string()).filter(|s| !s.is_empty());
+        if let Some(pattern) = &per_world
+            && !pattern.contains("{world}")
+        {
+            return Err(format!(
+                "model_per_world {pattern}: the path has no {{world}} in it"
+            ));
+        }
         let model = match (given, &per_world) {
             (Some(path), None) => Arc::new(VaModel::load(path).map_err(|e| e.to_string())?),
             // with {world}, the shipped model stands in until a reset loads the task's own card

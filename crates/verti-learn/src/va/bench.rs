@@ -20,8 +20,9 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use verti_va::adapter::AdaptMode;
 use verti_va::data::VaData;
-use verti_va::eval::{ErrorSums, errors};
+use verti_va::eval::{ErrorSums, errors, online_errors};
 use verti_va::{Method, VaModel};
 
 /// What to run.
@@ -37,6 +38,8 @@ pub struct BenchConfig {
     pub stride: usize,
     /// Multiplies the baselines' adaptation steps (1 = the paper's protocol).
     pub adapt_scale: f64,
+    /// Also score VertiAdaptor adapting online along the queries (every 5 s, and RLS).
+    pub online: bool,
     pub out: PathBuf,
 }
 
@@ -145,20 +148,26 @@ pub fn run(
     let mut done = 0;
     for (label, model) in &models {
         let path = rows_path(&cfg.out, label);
-        let finished: Vec<usize> = if path.exists() {
+        let rows_so_far = if cfg.out.exists() {
             read_rows(&cfg.out)?
-                .into_iter()
-                .filter(|r| &r.label == label && r.adapted)
-                .map(|r| r.world)
-                .collect()
         } else {
             Vec::new()
         };
+        let finished = |l: &str| -> Vec<usize> {
+            rows_so_far
+                .iter()
+                .filter(|r| r.label == l && r.adapted)
+                .map(|r| r.world)
+                .collect()
+        };
+        let (main_done, online_done) = (finished(label), finished(&format!("{label}-slide")));
+        let online = cfg.online && model.card.method == Method::Va;
         for (world, trajs) in &envs {
             done += 1;
             progress(done, total, label);
             let world_id = data.worlds[*world].meta.index as usize;
-            if finished.contains(&world_id) {
+            let main_needed = !main_done.contains(&world_id);
+            if !main_needed && !(online && !online_done.contains(&world_id)) {
                 continue;
             }
             let (ex, queries) = trajs.split_at(cfg.examples);
@@ -175,10 +184,15 @@ pub fn run(
                 level: format!("{level:?}").to_lowercase(),
                 adapt_s: 0.0,
                 example_points: examples.len(),
-                sums: score(model, &model.card.alpha_prior),
+                sums: if main_needed {
+                    score(model, &model.card.alpha_prior)
+                } else {
+                    ErrorSums::new(cfg.horizon)
+                },
             };
             let started = Instant::now();
             let sums = match Protocol::of(model.card.method, cfg.adapt_scale) {
+                _ if !main_needed => (0.0, ErrorSums::new(cfg.horizon)),
                 None => {
                     let alpha = model.adapt(&examples).map_err(|e| e.to_string())?;
                     let s = started.elapsed().as_secs_f64();
@@ -190,16 +204,72 @@ pub fn run(
                     (s, score(&adapted, &[1.0]))
                 }
             };
-            append(&path, &base)?;
-            append(
-                &path,
-                &Row {
-                    adapted: true,
-                    adapt_s: sums.0,
-                    sums: sums.1,
-                    ..base.clone()
-                },
-            )?;
+            if main_needed {
+                append(&path, &base)?;
+                append(
+                    &path,
+                    &Row {
+                        adapted: true,
+                        adapt_s: sums.0,
+                        sums: sums.1,
+                        ..base.clone()
+                    },
+                )?;
+            }
+            if online && !online_done.contains(&world_id) {
+                // online adaptation along the queries, from the adapted (once) coefficients
+                // for comparison with them: VA† (every 5 s on the last 5 s), RLS, and a
+                // sliding-window solve every step
+                let once = model.adapt(&examples).map_err(|e| e.to_string())?;
+                let shared = std::sync::Arc::new(model.clone());
+                for (suffix, mode) in [
+                    (
+                        "every",
+                        AdaptMode::Every {
+                            period: 5.0,
+                            window: 5.0,
+                        },
+                    ),
+                    ("rls", AdaptMode::Rls { forgetting: 0.98 }),
+                    // a least-squares solve every step on the last 5 s: how much of RLS's
+                    // gain is the update rate rather than the recursion
+                    (
+                        "slide",
+                        AdaptMode::Every {
+                            period: 0.1,
+                            window: 5.0,
+                        },
+                    ),
+                ] {
+                    if online_done.contains(&world_id)
+                        || rows_so_far
+                            .iter()
+                            .any(|r| r.world == world_id && r.label == format!("{label}-{suffix}"))
+                    {
+                        continue;
+                    }
+                    let label = format!("{label}-{suffix}");
+                    let sums = online_errors(
+                        &shared,
+                        mode,
+                        &once,
+                        &data,
+                        queries,
+                        cfg.horizon,
+                        cfg.stride,
+                    );
+                    append(
+                        &rows_path(&cfg.out, &label),
+                        &Row {
+                            label,
+                            adapted: true,
+                            adapt_s: 0.0,
+                            sums,
+                            ..base.clone()
+                        },
+                    )?;
+                }
+            }
         }
     }
     Ok(())

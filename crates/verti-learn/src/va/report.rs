@@ -23,7 +23,7 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// The paper's order of its rows; other labels follow alphabetically.
-const ORDER: [&str; 7] = [
+const ORDER: [&str; 12] = [
     "va",
     "node",
     "maml",
@@ -31,7 +31,16 @@ const ORDER: [&str; 7] = [
     "va-no-semantics",
     "va-no-elevation",
     "va-no-both",
+    "va-every",
+    "va-slide",
+    "va-rls",
+    "va-small",
+    "va-small-rls",
 ];
+
+/// The figures show the paper's four methods and RLS (when they are there): more lines
+/// than that do not read.
+const FIGURE: [&str; 5] = ["va", "node", "maml", "mlp", "va-rls"];
 
 /// The labels in the rows, in the paper's order.
 fn labels(rows: &[Row]) -> Vec<String> {
@@ -55,6 +64,18 @@ pub fn write(out: &Path, mse_steps: usize) -> Result<String, String> {
     }
     let pool = pooled(&rows);
     let labels = labels(&rows);
+    let in_figure: Vec<String> = {
+        let chosen: Vec<String> = labels
+            .iter()
+            .filter(|l| FIGURE.contains(&l.as_str()))
+            .cloned()
+            .collect();
+        if chosen.is_empty() {
+            labels.clone()
+        } else {
+            chosen
+        }
+    };
     let fmt = |v: f64| {
         if v.is_finite() {
             format!("{v:.4}")
@@ -106,11 +127,13 @@ pub fn write(out: &Path, mse_steps: usize) -> Result<String, String> {
                 mae.map(|v| format!("{v:.4}")).join(" | "),
                 mean
             ));
-            bars.push(Series {
-                name: l.clone(),
-                values: mae.to_vec(),
-                errors: None,
-            });
+            if in_figure.contains(l) {
+                bars.push(Series {
+                    name: l.clone(),
+                    values: mae.to_vec(),
+                    errors: None,
+                });
+            }
         }
     }
     let panel = Panel {
@@ -126,7 +149,7 @@ pub fn write(out: &Path, mse_steps: usize) -> Result<String, String> {
     let mut img = image::RgbImage::from_pixel(1400, 460, image::Rgb([255, 255, 255]));
     for (p, angular) in [false, true].into_iter().enumerate() {
         let mut series = Vec::new();
-        for l in &labels {
+        for l in &in_figure {
             if let Some((s, _)) = pool.get(&(l.clone(), true, "high".to_string())) {
                 series.push(LineSeries {
                     name: l.clone(),
