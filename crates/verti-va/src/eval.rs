@@ -6,10 +6,11 @@
 //! measured relative to the start, in its heading frame: forward, left, up (m, full scale)
 //! and yaw, roll, pitch (rad).
 
-use crate::data::VaData;
+use crate::data::{VaData, VaTrajectory};
 use crate::model::{EMBED, POSE_DIM, VaModel};
 use rayon::prelude::*;
 use verti_core::math::wrap_angle;
+use verti_kino::features::Units;
 use verti_kino::features::heading_delta;
 
 /// Sums of errors over many predictions.
@@ -90,6 +91,66 @@ impl ErrorSums {
     }
 }
 
+/// Adds the one-step error of predicting step `t` of `traj` with `predict`.
+fn score_step(
+    sums: &mut ErrorSums,
+    traj: &VaTrajectory,
+    units: Units,
+    t: usize,
+    predict: &dyn Fn(usize, f64, f64) -> [f64; POSE_DIM],
+) {
+    let p = &traj.poses[t];
+    let d = predict(t, p.roll, p.pitch);
+    let truth = traj.delta(t, units);
+    for k in 0..POSE_DIM {
+        let e = d[k] - truth[k];
+        sums.one_step_abs[k] += e.abs();
+        sums.one_step_sq[k] += e * e;
+    }
+    sums.one_step_count += 1;
+}
+
+/// Adds the errors of an open-loop rollout of `traj` from pose `start` (`predict` gives the
+/// change at step t from roll and pitch), relative to the start in its heading frame.
+fn score_rollout(
+    sums: &mut ErrorSums,
+    traj: &VaTrajectory,
+    units: Units,
+    start: usize,
+    predict: &dyn Fn(usize, f64, f64) -> [f64; POSE_DIM],
+) {
+    let p0 = &traj.poses[start];
+    // relative pose: forward, left, up, yaw, roll and pitch changes
+    let mut s = [0.0; POSE_DIM];
+    for t in 0..sums.step_sq.len() {
+        let d = predict(start + t, p0.roll + s[4], p0.pitch + s[5]);
+        let (sn, cs) = s[3].sin_cos();
+        s[0] += cs * d[0] - sn * d[1];
+        s[1] += sn * d[0] + cs * d[1];
+        s[2] += d[2];
+        s[3] = wrap_angle(s[3] + d[3]);
+        s[4] += d[4];
+        s[5] += d[5];
+        let truth = units.delta_to_model(&heading_delta(p0, &traj.poses[start + t + 1]));
+        let mut e = [0.0; POSE_DIM];
+        for k in 0..POSE_DIM {
+            e[k] = if k == 3 {
+                wrap_angle(s[k] - truth[k])
+            } else {
+                s[k] - truth[k]
+            };
+            sums.step_sq[t][k] += e[k] * e[k];
+        }
+        let pos = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+        let ang = (e[3] * e[3] + e[4] * e[4] + e[5] * e[5]).sqrt();
+        sums.step_pos[t][0] += pos;
+        sums.step_pos[t][1] += pos * pos;
+        sums.step_ang[t][0] += ang;
+        sums.step_ang[t][1] += ang * ang;
+    }
+    sums.rollouts += 1;
+}
+
 /// Errors of `model` with coefficients `alpha` on `trajectories` of `data`: every one-step
 /// prediction, and rollouts of `horizon` steps starting every `stride` steps.
 pub fn errors(
@@ -112,50 +173,11 @@ pub fn errors(
                 model.predict(alpha, roll, pitch, &embeddings[t], traj.commands[t])
             };
             for t in 0..n - 1 {
-                let p = &traj.poses[t];
-                let d = predict(t, p.roll, p.pitch);
-                let truth = traj.delta(t, data.units);
-                for k in 0..POSE_DIM {
-                    let e = d[k] - truth[k];
-                    sums.one_step_abs[k] += e.abs();
-                    sums.one_step_sq[k] += e * e;
-                }
-                sums.one_step_count += 1;
+                score_step(&mut sums, traj, data.units, t, &predict);
             }
             let mut start = 0;
             while start + horizon < n {
-                let p0 = &traj.poses[start];
-                // relative pose: forward, left, up, yaw, roll and pitch changes
-                let mut s = [0.0; POSE_DIM];
-                for t in 0..horizon {
-                    let d = predict(start + t, p0.roll + s[4], p0.pitch + s[5]);
-                    let (sn, cs) = s[3].sin_cos();
-                    s[0] += cs * d[0] - sn * d[1];
-                    s[1] += sn * d[0] + cs * d[1];
-                    s[2] += d[2];
-                    s[3] = wrap_angle(s[3] + d[3]);
-                    s[4] += d[4];
-                    s[5] += d[5];
-                    let truth = data
-                        .units
-                        .delta_to_model(&heading_delta(p0, &traj.poses[start + t + 1]));
-                    let mut e = [0.0; POSE_DIM];
-                    for k in 0..POSE_DIM {
-                        e[k] = if k == 3 {
-                            wrap_angle(s[k] - truth[k])
-                        } else {
-                            s[k] - truth[k]
-                        };
-                        sums.step_sq[t][k] += e[k] * e[k];
-                    }
-                    let pos = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
-                    let ang = (e[3] * e[3] + e[4] * e[4] + e[5] * e[5]).sqrt();
-                    sums.step_pos[t][0] += pos;
-                    sums.step_pos[t][1] += pos * pos;
-                    sums.step_ang[t][0] += ang;
-                    sums.step_ang[t][1] += ang * ang;
-                }
-                sums.rollouts += 1;
+                score_rollout(&mut sums, traj, data.units, start, &predict);
                 start += stride;
             }
             sums
@@ -200,48 +222,10 @@ pub fn online_errors(
                 model.predict(&alpha, roll, pitch, &embeddings[t], traj.commands[t])
             };
             if s + 1 < n {
-                let p = &traj.poses[s];
-                let d = predict(s, p.roll, p.pitch);
-                let truth = traj.delta(s, data.units);
-                for k in 0..POSE_DIM {
-                    let e = d[k] - truth[k];
-                    sums.one_step_abs[k] += e.abs();
-                    sums.one_step_sq[k] += e * e;
-                }
-                sums.one_step_count += 1;
+                score_step(&mut sums, traj, data.units, s, &predict);
             }
             if s % stride == 0 && s + horizon < n {
-                let p0 = &traj.poses[s];
-                let mut st = [0.0; POSE_DIM];
-                for t in 0..horizon {
-                    let d = predict(s + t, p0.roll + st[4], p0.pitch + st[5]);
-                    let (sn, cs) = st[3].sin_cos();
-                    st[0] += cs * d[0] - sn * d[1];
-                    st[1] += sn * d[0] + cs * d[1];
-                    st[2] += d[2];
-                    st[3] = wrap_angle(st[3] + d[3]);
-                    st[4] += d[4];
-                    st[5] += d[5];
-                    let truth = data
-                        .units
-                        .delta_to_model(&heading_delta(p0, &traj.poses[s + t + 1]));
-                    let mut e = [0.0; POSE_DIM];
-                    for k in 0..POSE_DIM {
-                        e[k] = if k == 3 {
-                            wrap_angle(st[k] - truth[k])
-                        } else {
-                            st[k] - truth[k]
-                        };
-                        sums.step_sq[t][k] += e[k] * e[k];
-                    }
-                    let pos = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
-                    let ang = (e[3] * e[3] + e[4] * e[4] + e[5] * e[5]).sqrt();
-                    sums.step_pos[t][0] += pos;
-                    sums.step_pos[t][1] += pos * pos;
-                    sums.step_ang[t][0] += ang;
-                    sums.step_ang[t][1] += ang * ang;
-                }
-                sums.rollouts += 1;
+                score_rollout(&mut sums, traj, data.units, s, &predict);
             }
             // the command is in model units; the adapter takes world units
             let (v, steer) = traj.commands[s];

@@ -47,24 +47,16 @@ pub fn drives_to_examples(
     model: &VaModel,
     encoder: &PatchEncoder,
 ) -> Vec<Example> {
-    let scale = world.meta.scale;
-    let units = Units::new(scale);
-    let mut latent = [0f32; TERRAIN_DIM];
-    let mut out = Vec::new();
-    for drive in drives {
-        for w in drive.windows(2) {
-            let (p, (v, s)) = w[0];
-            terrain_latent(world, &p, scale, encoder, &mut latent);
-            out.push(Example {
-                roll: p.roll,
-                pitch: p.pitch,
-                embedding: model.embed(&latent),
-                command: (v / scale.sqrt(), s),
-                delta: units.delta_to_model(&heading_delta(&p, &w[1].0)),
-            });
-        }
-    }
-    out
+    drives_to_rows(drives, world, encoder)
+        .into_iter()
+        .map(|(latent, roll, pitch, command, delta)| Example {
+            roll,
+            pitch,
+            embedding: model.embed(&latent),
+            command,
+            delta,
+        })
+        .collect()
 }
 
 /// One step's raw inputs and target: terrain latent, roll, pitch, full-scale command, change.

@@ -206,3 +206,58 @@ fn the_va_system_drives_with_every_adaptation_mode() {
         );
     }
 }
+
+/// A straight 3 s drive over made-up terrain latents, as a dataset.
+fn synthetic_data() -> verti_va::data::VaData {
+    let mut rng = Rng::new(8);
+    let n = 30;
+    let poses: Vec<Pose6> = (0..n)
+        .map(|i| Pose6 {
+            x: 0.2 * i as f64,
+            roll: 0.02 * (i as f64).sin(),
+            ..Pose6::default()
+        })
+        .collect();
+    let terrain: Vec<f32> = (0..n * verti_va::terrain::TERRAIN_DIM)
+        .map(|_| rng.range(-1.0, 1.0) as f32)
+        .collect();
+    verti_va::data::VaData {
+        worlds: Vec::new(),
+        trajectories: vec![verti_va::data::VaTrajectory {
+            world: 0,
+            level: verti_world::ElevationLevel::Low,
+            poses,
+            commands: vec![(2.0, 0.1); n],
+            terrain,
+        }],
+        units: verti_kino::features::Units::new(1.0),
+        dt: 0.1,
+        vehicle: "hmmwv".into(),
+        set: "synthetic".into(),
+        eval_worlds: false,
+        hours: 0.0,
+        dir: std::path::PathBuf::new(),
+    }
+}
+
+#[test]
+fn online_scoring_without_adaptation_matches_offline_scoring() {
+    let model = Arc::new(tiny(Method::Va, 3, 6));
+    let data = synthetic_data();
+    let prior = model.card.alpha_prior.clone();
+    let offline = verti_va::eval::errors(&model, &prior, &data, &[0], 8, 5);
+    let online = verti_va::eval::online_errors(&model, AdaptMode::None, &prior, &data, &[0], 8, 5);
+    assert_eq!(offline, online);
+    assert_eq!((offline.one_step_count, offline.rollouts), (29, 5));
+    // adapting online changes the scores
+    let rls = verti_va::eval::online_errors(
+        &model,
+        AdaptMode::Rls { forgetting: 0.98 },
+        &prior,
+        &data,
+        &[0],
+        8,
+        5,
+    );
+    assert_ne!(rls, offline);
+}
