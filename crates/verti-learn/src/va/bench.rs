@@ -167,7 +167,8 @@ pub fn run(
             progress(done, total, label);
             let world_id = data.worlds[*world].meta.index as usize;
             let main_needed = !main_done.contains(&world_id);
-            if !main_needed && !(online && !online_done.contains(&world_id)) {
+            let online_needed = online && !online_done.contains(&world_id);
+            if !main_needed && !online_needed {
                 continue;
             }
             let (ex, queries) = trajs.split_at(cfg.examples);
@@ -216,7 +217,7 @@ pub fn run(
                     },
                 )?;
             }
-            if online && !online_done.contains(&world_id) {
+            if online_needed {
                 // online adaptation along the queries, from the adapted (once) coefficients
                 // for comparison with them: VA† (every 5 s on the last 5 s), RLS, and a
                 // sliding-window solve every step
