@@ -11,7 +11,7 @@ use verti_bench::{MobilitySystem, SystemInfo, SystemRegistry};
 use verti_core::Factory;
 use verti_core::params::{ParamError, ParamSpec, ParamValue, Params};
 use verti_systems::mppi::Mppi;
-use verti_systems::registry::{mppi_from, mppi_params};
+use verti_systems::registry::{mppi_among, mppi_params};
 use verti_systems::rollout::PathCostWeights;
 
 /// Where a system's default model comes from (the shipped weights, loaded once).
@@ -146,16 +146,7 @@ impl Factory<dyn MobilitySystem> for LearnedSystem {
             }
             _ => self.loaded.get_or_init(|| (self.default_model)()).clone()?,
         };
-        // `step` is not a parameter here: one rollout step is one model step
-        let specs = mppi_params();
-        let mut pairs: Vec<(String, ParamValue)> = p
-            .to_pairs()
-            .into_iter()
-            .filter(|(n, _)| specs.iter().any(|s| &s.name == n))
-            .collect();
-        pairs.push(("step".into(), ParamValue::Float(file.card.dt)));
-        let mppi =
-            mppi_from(&Params::resolve(self.name, specs, &pairs).map_err(|e| e.to_string())?);
+        let mppi = mppi_among(self.name, p, Some(file.card.dt))?;
         let weights = AttitudeWeights {
             path: PathCostWeights {
                 goal: p.float("w_goal"),

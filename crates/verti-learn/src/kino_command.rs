@@ -40,16 +40,28 @@ pub struct KinoTrained {
     pub val_examples: usize,
 }
 
-fn load(dir: &Path, dt: f64, what: &str) -> Result<KinoData, String> {
-    let data = KinoData::load(dir, dt).map_err(|e| format!("{what} data: {e}"))?;
-    if data.eval_worlds {
+/// Refuses `what` data in `dir` driven on evaluation worlds: `verti learn` never trains or
+/// validates on them.
+pub(crate) fn refuse_eval_worlds(
+    what: &str,
+    dir: &Path,
+    eval_worlds: bool,
+    set: &str,
+) -> Result<(), String> {
+    if eval_worlds {
         return Err(format!(
-            "{what} data {} were driven on the evaluation set {}; train on other seeds \
+            "{what} data {} were driven on the evaluation set {set}; train on other seeds \
              (verti-100-s1, ...)",
-            dir.display(),
-            data.set
+            dir.display()
         ));
     }
+    Ok(())
+}
+
+/// A kinodynamic dataset cut at step `dt`, refused if driven on evaluation worlds.
+pub(crate) fn load(dir: &Path, dt: f64, what: &str) -> Result<KinoData, String> {
+    let data = KinoData::load(dir, dt).map_err(|e| format!("{what} data: {e}"))?;
+    refuse_eval_worlds(what, dir, data.eval_worlds, &data.set)?;
     Ok(data)
 }
 

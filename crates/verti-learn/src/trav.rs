@@ -13,11 +13,11 @@ use crate::seq::{Act, SeqNet, values};
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor, TensorData};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 use verti_core::Rng;
-use verti_kino::samples::{Examples, KinoData};
+use verti_kino::samples::Examples;
 use verti_kino::traversability::{
     CHANNELS, FIELD, LABEL_HORIZON, OUTPUTS, RISK_ANGLE, SPACING, Traversability,
 };
@@ -118,18 +118,6 @@ pub struct TravTrained {
     pub wall_time_s: f64,
 }
 
-fn load(dir: &Path, dt: f64, what: &str) -> Result<KinoData, String> {
-    let data = KinoData::load(dir, dt).map_err(|e| format!("{what} data: {e}"))?;
-    if data.eval_worlds {
-        return Err(format!(
-            "{what} data {} were driven on the evaluation set {}; train on other seeds",
-            dir.display(),
-            data.set
-        ));
-    }
-    Ok(data)
-}
-
 /// Trains, checks and writes the traversability network.
 pub fn learn_trav(
     run: &TravRun,
@@ -139,8 +127,8 @@ pub fn learn_trav(
     let cfg = &run.config;
     cfg.validate()?;
     let (train_data, val_data) = (
-        load(&run.data, run.dt, "training")?,
-        load(&run.val, run.dt, "validation")?,
+        crate::kino_command::load(&run.data, run.dt, "training")?,
+        crate::kino_command::load(&run.val, run.dt, "validation")?,
     );
     let (train, val) = (
         train_data.traversability_examples(),

@@ -15,7 +15,7 @@ use verti_bench::{MobilitySystem, SystemInfo, SystemRegistry};
 use verti_core::Factory;
 use verti_core::params::{ParamError, ParamSpec, ParamValue, Params};
 use verti_systems::mppi::Mppi;
-use verti_systems::registry::{mppi_from, mppi_params};
+use verti_systems::registry::{mppi_among, mppi_params};
 
 /// Where the default model comes from (the shipped weights, loaded once).
 pub type ModelSource = fn() -> Result<Arc<TravModel>, String>;
@@ -114,13 +114,7 @@ impl Factory<dyn MobilitySystem> for PietraSystem {
                 _ => self.loaded.get_or_init(self.default_model).clone()?,
             })
         };
-        let specs = mppi_params();
-        let pairs: Vec<(String, ParamValue)> = p
-            .to_pairs()
-            .into_iter()
-            .filter(|(n, _)| specs.iter().any(|s| &s.name == n))
-            .collect();
-        let mppi = mppi_from(&Params::resolve("pietra", specs, &pairs).map_err(|e| e.to_string())?);
+        let mppi = mppi_among("pietra", p, None)?;
         let weights = TimeWeights {
             ood: p.float("w_ood"),
             v_post: p.float("v_post"),

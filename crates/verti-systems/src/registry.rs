@@ -136,6 +136,25 @@ pub fn mppi_params() -> Vec<ParamSpec> {
     ]
 }
 
+/// The [`MppiParams`] among the parameters `p` of system `owner`, which may declare more than
+/// [`mppi_params`] (its own model and cost settings). `step`, when given, replaces the rollout
+/// step: systems whose rollouts advance one model step at a time do not offer it.
+pub fn mppi_among(owner: &str, p: &Params, step: Option<f64>) -> Result<MppiParams, String> {
+    let specs = mppi_params();
+    let mut pairs: Vec<(String, ParamValue)> = p
+        .to_pairs()
+        .into_iter()
+        .filter(|(n, _)| specs.iter().any(|s| &s.name == n))
+        .collect();
+    if let Some(step) = step {
+        pairs.retain(|(n, _)| n != "step");
+        pairs.push(("step".into(), ParamValue::Float(step)));
+    }
+    Ok(mppi_from(
+        &Params::resolve(owner, specs, &pairs).map_err(|e| e.to_string())?,
+    ))
+}
+
 /// [`MppiParams`] from parameters declared by [`mppi_params`] (cost weights, when not
 /// declared, at their defaults).
 pub fn mppi_from(p: &Params) -> MppiParams {

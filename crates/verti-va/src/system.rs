@@ -23,7 +23,7 @@ use verti_core::params::{ParamSpec, ParamValue, Params};
 use verti_kino::rollout::{AttitudeCost, AttitudeWeights};
 use verti_nn::patch::PatchEncoder;
 use verti_systems::mppi::Mppi;
-use verti_systems::registry::{mppi_from, mppi_params};
+use verti_systems::registry::{mppi_among, mppi_params};
 use verti_systems::rollout::PathCostWeights;
 
 /// Coefficients of `once` per (world, model, exploration), shared by the trials of a process.
@@ -295,14 +295,7 @@ impl Factory<dyn MobilitySystem> for VaSystem {
             // with {world}, the shipped model stands in until a reset loads the task's own card
             _ => self.loaded.get_or_init(|| (self.default_model)()).clone()?,
         };
-        let specs = mppi_params();
-        let mut pairs: Vec<(String, ParamValue)> = p
-            .to_pairs()
-            .into_iter()
-            .filter(|(n, _)| specs.iter().any(|s| &s.name == n))
-            .collect();
-        pairs.push(("step".into(), ParamValue::Float(model.card.dt)));
-        let mppi = mppi_from(&Params::resolve("va", specs, &pairs).map_err(|e| e.to_string())?);
+        let mppi = mppi_among("va", p, Some(model.card.dt))?;
         let weights = AttitudeWeights {
             path: PathCostWeights {
                 goal: mppi.w_goal,

@@ -191,18 +191,26 @@ pub fn run(
                     ErrorSums::new(cfg.horizon)
                 },
             };
-            let started = Instant::now();
-            let sums = match Protocol::of(model.card.method, cfg.adapt_scale) {
+            // VertiAdaptor's one solve (timed): the adapted row's coefficients, and where the
+            // online rows start from
+            let solve = if model.card.method == Method::Va {
+                let started = Instant::now();
+                let alpha = model.adapt(&examples).map_err(|e| e.to_string())?;
+                Some((started.elapsed().as_secs_f64(), alpha))
+            } else {
+                None
+            };
+            let sums = match (Protocol::of(model.card.method, cfg.adapt_scale), &solve) {
                 _ if !main_needed => (0.0, ErrorSums::new(cfg.horizon)),
-                None => {
-                    let alpha = model.adapt(&examples).map_err(|e| e.to_string())?;
-                    let s = started.elapsed().as_secs_f64();
-                    (s, score(model, &alpha))
-                }
-                Some(p) => {
+                (Some(p), _) => {
+                    let started = Instant::now();
                     let adapted = adapt_gradient(model, &points(&data, ex), p, device)?;
                     let s = started.elapsed().as_secs_f64();
                     (s, score(&adapted, &[1.0]))
+                }
+                (None, Some((s, alpha))) => (*s, score(model, alpha)),
+                (None, None) => {
+                    return Err(format!("{label}: no adaptation protocol and no solve"));
                 }
             };
             if main_needed {
@@ -221,7 +229,9 @@ pub fn run(
                 // online adaptation along the queries, from the adapted (once) coefficients
                 // for comparison with them: VA† (every 5 s on the last 5 s), RLS, and a
                 // sliding-window solve every step
-                let once = model.adapt(&examples).map_err(|e| e.to_string())?;
+                let Some((_, once)) = &solve else {
+                    return Err(format!("{label}: online rows need a least-squares solve"));
+                };
                 let shared = std::sync::Arc::new(model.clone());
                 for (suffix, mode) in [
                     (
@@ -250,15 +260,8 @@ pub fn run(
                         continue;
                     }
                     let label = format!("{label}-{suffix}");
-                    let sums = online_errors(
-                        &shared,
-                        mode,
-                        &once,
-                        &data,
-                        queries,
-                        cfg.horizon,
-                        cfg.stride,
-                    );
+                    let sums =
+                        online_errors(&shared, mode, once, &data, queries, cfg.horizon, cfg.stride);
                     append(
                         &rows_path(&cfg.out, &label),
                         &Row {

@@ -21,14 +21,7 @@ pub fn load_data(
     let encoder = verti_nn::shipped::patch_v1()?;
     let data =
         VaData::load(dir, dt, &encoder, progress).map_err(|e| format!("{what} data: {e}"))?;
-    if data.eval_worlds {
-        return Err(format!(
-            "{what} data {} were driven on the evaluation set {}; train on other seeds \
-             (verti-100-s1, ...)",
-            dir.display(),
-            data.set
-        ));
-    }
+    crate::kino_command::refuse_eval_worlds(what, dir, data.eval_worlds, &data.set)?;
     Ok(data)
 }
 
