@@ -105,9 +105,14 @@ impl Adapter {
         self.last_solve = 0.0;
         self.examples = 0;
         self.solves = 0;
-        self.rls = match self.mode {
+        self.rls = self.fresh_rls();
+    }
+
+    /// A recursive least-squares state starting from the current coefficients (`rls` only):
+    /// they count like ten seconds of data (100 model steps).
+    fn fresh_rls(&self) -> Option<Rls> {
+        match self.mode {
             AdaptMode::Rls { forgetting } => {
-                // the prior counts like a window of ten seconds of data (100 model steps)
                 let information = 100.0 * self.model.card.lambda.max(1e-6);
                 Some(Rls::new(
                     self.alpha.clone(),
@@ -117,13 +122,15 @@ impl Adapter {
                 ))
             }
             _ => None,
-        };
+        }
     }
 
     /// Sets the coefficients outright (`once`: the solve on pre-task data).
+    /// Recursive least squares then continues from them.
     pub fn set_alpha(&mut self, alpha: Vec<f64>) {
         debug_assert_eq!(alpha.len(), self.alpha.len());
         self.alpha = alpha;
+        self.rls = self.fresh_rls();
         self.solves += 1;
     }
 

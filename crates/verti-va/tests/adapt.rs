@@ -261,3 +261,35 @@ fn online_scoring_without_adaptation_matches_offline_scoring() {
     );
     assert_ne!(rls, offline);
 }
+
+#[test]
+fn recursive_least_squares_continues_from_coefficients_set_outright() {
+    let model = Arc::new(tiny(Method::Va, 3, 9));
+    let start = vec![5.0, -5.0, 5.0];
+    let mut rls = Adapter::new(model, AdaptMode::Rls { forgetting: 0.98 });
+    rls.reset(1.0);
+    rls.set_alpha(start.clone());
+    for i in 0..=1 {
+        let pose = Pose6 {
+            x: 0.2 * i as f64,
+            ..Pose6::default()
+        };
+        rls.observe(0.1 * i as f64, pose, (2.0, 0.0), &mut |_| [0.0; 16]);
+    }
+    assert_eq!(rls.examples, 1);
+    // one example moves the coefficients only within its 6-dimensional span: they stay far
+    // nearer the start than the prior (1/3 each)
+    let dist = |a: &[f64], b: &[f64]| -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let prior = vec![1.0 / 3.0; 3];
+    assert!(
+        dist(rls.alpha(), &start) < dist(rls.alpha(), &prior),
+        "{:?}",
+        rls.alpha()
+    );
+}
