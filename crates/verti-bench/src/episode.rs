@@ -88,6 +88,8 @@ pub struct EpisodeConfig {
     pub seed: u64,
     /// How the vehicle starts.
     pub start: StartMode,
+    /// Perception noise on what the system observes (None: ground truth, the paper's setting).
+    pub perception: Option<std::sync::Arc<crate::perception::PerceptionModel>>,
 }
 
 impl Default for EpisodeConfig {
@@ -104,6 +106,7 @@ impl Default for EpisodeConfig {
             log_seconds: None,
             seed: 0,
             start: StartMode::Settled,
+            perception: None,
         }
     }
 }

@@ -326,6 +326,12 @@ pub fn evaluate(
         setup.episode.start,
         setup.step_log.as_ref().map(|s| s.seconds),
     );
+    record.perception = setup
+        .episode
+        .perception
+        .as_deref()
+        .filter(|m| !m.is_none())
+        .cloned();
 
     let mut previous = Vec::new();
     if results_path.exists() && !setup.force {

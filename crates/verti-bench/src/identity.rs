@@ -94,6 +94,9 @@ pub struct RunRecord {
     /// resume may extend them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tasks: Option<String>,
+    /// Perception noise on what the system observed (absent: ground truth).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub perception: Option<crate::perception::PerceptionModel>,
 }
 
 impl RunRecord {
@@ -113,6 +116,7 @@ impl RunRecord {
             start,
             step_log: step_log_label(step_log),
             tasks: None,
+            perception: None,
         }
     }
 
@@ -185,6 +189,22 @@ impl RunRecord {
             recorded.step_log.clone().unwrap_or("none".into()),
             self.step_log.clone().unwrap_or("none".into()),
         );
+        if recorded.perception != self.perception {
+            let name = |p: &Option<crate::perception::PerceptionModel>| {
+                p.as_ref()
+                    .map_or("none".to_string(), |m| format!("`{}`", m.name))
+            };
+            out.push(format!(
+                "perception: {} recorded, {} now{}",
+                name(&recorded.perception),
+                name(&self.perception),
+                if name(&recorded.perception) == name(&self.perception) {
+                    " (same name, different parameters)"
+                } else {
+                    ""
+                }
+            ));
+        }
         if a.system == b.system {
             out.extend(param_differences(&b.params, &a.params));
         }

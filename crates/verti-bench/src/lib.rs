@@ -14,7 +14,9 @@
 //! * [`features`]: the one schema of named state features (step logs, state vectors).
 //! * [`path`]: following the global path (local goal, heading error), for systems and rewards.
 //! * [`metrics`]: per-trial metrics and their aggregation into the paper's Table I and Fig. 6.
-//! * [`eval`]: parallel, deterministic, resumable evaluation over task ranges.
+//! * [`eval`]: parallel, deterministic, resumable evaluation over task ranges; [`shard`]
+//!   splits one over machines and joins the pieces.
+//! * [`perception`]: seeded perception noise on what systems observe (never on the physics).
 
 pub mod episode;
 pub mod eval;
@@ -23,7 +25,9 @@ pub mod identity;
 pub mod metrics;
 pub mod observation;
 pub mod path;
+pub mod perception;
 pub mod report;
+pub mod shard;
 pub mod speed;
 pub mod system;
 pub mod trial;

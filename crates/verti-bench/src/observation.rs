@@ -11,6 +11,7 @@
 //! sees the fields above only.
 
 use crate::features::FeatureSource;
+use crate::perception::Sensing;
 use crate::trial::Trial;
 use verti_core::Vec3;
 use verti_sim::Controls;
@@ -72,6 +73,8 @@ pub struct Observation<'a> {
     vehicle: FeatureSource,
     /// The trial observed (privileged; see [`Observation::trial`]).
     trial: Option<&'a Trial>,
+    /// Range limit and latency of map reads under perception noise (None: ideal sensing).
+    sensing: Option<Sensing>,
 }
 
 impl<'a> Observation<'a> {
@@ -96,7 +99,20 @@ impl<'a> Observation<'a> {
             world_scale: world.meta.scale,
             vehicle,
             trial: None,
+            sensing: None,
         }
+    }
+
+    /// This observation with map reads limited and displaced as `sensing` says (perception
+    /// noise; [`crate::perception`]).
+    pub fn with_sensing(mut self, sensing: Sensing) -> Self {
+        self.sensing = Some(sensing);
+        self
+    }
+
+    /// How the map is sensed (None: every cell, as it is).
+    pub fn sensing(&self) -> Option<&Sensing> {
+        self.sensing.as_ref()
     }
 
     /// This observation with privileged access to `trial`, the running trial it describes
@@ -157,18 +173,28 @@ impl<'a> Observation<'a> {
 
     /// Terrain height (m, undeformed) under each cell.
     pub fn elevation_crop(&self, spec: CropSpec) -> Crop<f64> {
-        self.crop(spec, |x, y| self.world.terrain.height_at(x, y))
+        self.crop(spec, |x, y| self.elevation_at(x, y))
     }
 
-    /// Semantic class id (Verti-Bench label ids 0..9) under each cell.
+    /// Semantic class id (Verti-Bench label ids 0..9) under each cell; out of sensing range,
+    /// the class under the vehicle.
     pub fn semantic_crop(&self, spec: CropSpec) -> Crop<u8> {
-        self.crop(spec, |x, y| self.world.patches.at(x, y).class.id())
+        self.crop(spec, |x, y| match &self.sensing {
+            None => self.world.patches.at(x, y).class.id(),
+            Some(s) if s.sees(x, y) => {
+                let (x, y) = s.lookup(x, y);
+                self.world.patches.at(x, y).class.id()
+            }
+            Some(s) => self.world.patches.at(s.centre[0], s.centre[1]).class.id(),
+        })
     }
 
     /// 1 where an obstacle footprint covers the cell centre, else 0. Off-map cells read 1 so
     /// planners keep to the map.
     pub fn occupancy_crop(&self, spec: CropSpec) -> Crop<u8> {
-        let reach = 0.75 * spec.size as f64 * spec.resolution;
+        // reads displaced by a perception latency land this much farther away
+        let shift = self.sensing.map_or(0.0, |s| s.shift[0].hypot(s.shift[1]));
+        let reach = 0.75 * spec.size as f64 * spec.resolution + shift;
         let near: Vec<&verti_world::Obstacle> = self
             .world
             .obstacles
@@ -182,8 +208,15 @@ impl<'a> Observation<'a> {
         // the bounding-circle test rejects almost every (cell, obstacle) pair before the
         // polygon test, which keeps large crops cheap enough for a 20 Hz planner
         self.crop(spec, |x, y| {
+            let off_map = !self.world.terrain.contains(x, y);
+            // under perception noise: nothing is known beyond range, and reads lag by the latency
+            let (x, y) = match &self.sensing {
+                None => (x, y),
+                Some(s) if s.sees(x, y) => s.lookup(x, y),
+                Some(_) => return u8::from(off_map),
+            };
             u8::from(
-                !self.world.terrain.contains(x, y)
+                off_map
                     || near.iter().any(|o| {
                         let p = o.position();
                         let r = o.radius_xy();
@@ -194,14 +227,30 @@ impl<'a> Observation<'a> {
         })
     }
 
-    /// Undeformed terrain height at a world point (ground truth, as the paper's systems get).
+    /// Undeformed terrain height at a world point (ground truth, as the paper's systems get;
+    /// under perception noise, the perceived map within sensing range, level ground beyond).
     pub fn elevation_at(&self, x: f64, y: f64) -> f64 {
-        self.world.terrain.height_at(x, y)
+        match &self.sensing {
+            None => self.world.terrain.height_at(x, y),
+            Some(s) if s.sees(x, y) => {
+                let (x, y) = s.lookup(x, y);
+                self.world.terrain.height_at(x, y)
+            }
+            Some(s) => s.ground,
+        }
     }
 
-    /// Horizontal distance from (x, y) to the nearest obstacle footprint (negative inside).
+    /// Horizontal distance from (x, y) to the nearest obstacle footprint (negative inside);
+    /// under perception noise, infinite beyond sensing range.
     pub fn obstacle_distance(&self, x: f64, y: f64) -> f64 {
-        self.world.obstacle_distance(x, y)
+        match &self.sensing {
+            None => self.world.obstacle_distance(x, y),
+            Some(s) if s.sees(x, y) => {
+                let (x, y) = s.lookup(x, y);
+                self.world.obstacle_distance(x, y)
+            }
+            Some(_) => f64::INFINITY,
+        }
     }
 
     /// Half of the map's side length (m): the map spans [-h, h] in x and y.

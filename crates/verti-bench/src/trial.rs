@@ -13,6 +13,7 @@ use crate::episode::{
 use crate::features::{FeatureSource, STEP_LOG};
 use crate::metrics::{AngleStats, SignalStats};
 use crate::observation::{Observation, Pose6};
+use crate::perception::Perception;
 use crate::speed::SpeedController;
 use crate::system::{Action, TaskInfo};
 use std::sync::Arc;
@@ -29,6 +30,9 @@ pub struct StepOutcome {
     /// Inner steps simulated.
     pub inner_steps: u32,
 }
+
+/// Seed stream of perception noise ("percept" in ASCII), mixed with the run seed and task.
+const PERCEPTION_STREAM: u64 = 0x0070_6572_6365_7074;
 
 /// One trial in progress. Cloning it branches the trial: the clone continues independently
 /// (the world and the simulator model are shared, the state is copied).
@@ -56,6 +60,8 @@ pub struct Trial {
     ended: Option<Outcome>,
     log: Option<EpisodeLog>,
     started: Instant,
+    /// What the system perceives, when perception noise is on (boxed: most trials have none).
+    perception: Option<Box<Perception>>,
 }
 
 /// The result of a trial that could not start (unknown pair, bad settings, no valid start).
@@ -178,6 +184,11 @@ impl Trial {
         pose: Pose6,
         result: TrialResult,
     ) -> Trial {
+        // the perception's draws are the task's own, apart from the system's (same run seed)
+        let perception = cfg.perception.as_ref().filter(|m| !m.is_none()).map(|m| {
+            let seed = mix_seed(&[cfg.seed, u64::from(result.task), PERCEPTION_STREAM]);
+            Box::new(Perception::new(world, m.clone(), seed))
+        });
         Trial {
             world: world.clone(),
             state,
@@ -194,6 +205,7 @@ impl Trial {
             ended: None,
             log: cfg.log_seconds.map(|_| EpisodeLog::default()),
             started: Instant::now(),
+            perception,
             cfg,
             sim,
         }
@@ -324,6 +336,10 @@ impl Trial {
             )));
             return out;
         }
+        // the estimator's error for the next observation: drift steps on, white noise redrawn
+        if let Some(p) = self.perception.as_mut() {
+            p.advance(period);
+        }
         // the same accumulation as a system acting at a fixed rate: the period ends at the
         // first inner step at or after the running sum of periods
         self.next_control += period;
@@ -451,13 +467,23 @@ impl Trial {
     /// The observation a system sees now, with privileged access to this trial
     /// ([`Observation::trial`]; only oracle-type systems may use it).
     pub fn observation(&self) -> Observation<'_> {
-        Observation::new(
-            &self.world,
-            self.features(),
-            self.task.goal,
-            &self.info.global_path,
-        )
+        let truth = self.features();
+        match &self.perception {
+            None => Observation::new(&self.world, truth, self.task.goal, &self.info.global_path),
+            Some(p) => Observation::new(
+                p.world(),
+                p.estimate(&truth),
+                self.task.goal,
+                &self.info.global_path,
+            )
+            .with_sensing(p.sensing(&self.pose, truth.forward_speed)),
+        }
         .with_trial(self)
+    }
+
+    /// The perception model's state, when perception noise is on.
+    pub fn perception(&self) -> Option<&Perception> {
+        self.perception.as_deref()
     }
 
     /// A branch of this trial for looking ahead: a clone without the step log (a planner's
@@ -486,6 +512,7 @@ impl Trial {
             ended: self.ended,
             log,
             started: self.started,
+            perception: self.perception.clone(),
         }
     }
 

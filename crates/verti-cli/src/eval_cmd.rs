@@ -87,6 +87,14 @@ pub struct EvalArgs {
     /// (what the failure-case dataset needs), `all` the whole trial.
     #[arg(long, value_parser = ["last10", "all"])]
     log_steps: Option<String>,
+    /// Perception noise on what the system observes (never on the physics): none (default),
+    /// low, medium, high, or a YAML file (see README "Perception noise").
+    #[arg(long, default_value = "none")]
+    perception: String,
+    /// Run only shard i of N (0 <= i < N) of the selected tasks, for cluster array jobs;
+    /// join the shards' directories with `verti merge`.
+    #[arg(long, value_parser = verti_bench::shard::Shard::parse)]
+    shard: Option<verti_bench::shard::Shard>,
 }
 
 /// The systems `--system` names: one name, a comma-separated list, or `all` (every registered
@@ -149,7 +157,8 @@ pub fn eval(a: EvalArgs) -> CmdResult {
             }
         }
     }
-    let selection = parse_tasks(&a.tasks)?;
+    let perception = verti_bench::perception::PerceptionModel::load(&a.perception)
+        .map_err(|e| format!("--perception: {e}"))?;
     let (set, scale) = load_set_checked(&a.worlds, &a.scale)?;
     let vehicle_name = a
         .vehicle
@@ -161,6 +170,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
     }
     let set_name = set.name.clone();
     let worlds: Vec<Arc<World>> = set.worlds.into_iter().map(Arc::new).collect();
+    let selection = shard_selection(&worlds, &a.tasks, a.shard)?;
     let per_system = verti_bench::eval::select_tasks(&worlds, &selection)?.len();
     // one progress display for the whole sequence
     let pb = bar((per_system * systems.len()) as u64, &systems.join(", "));
@@ -172,6 +182,8 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         };
         pb.set_message(system.clone());
         let shared = Shared {
+            selection: &selection,
+            perception: (!perception.is_none()).then(|| Arc::new(perception.clone())),
             registry: &registry,
             worlds: &worlds,
             vehicle: &vehicle,
@@ -193,8 +205,41 @@ pub fn eval(a: EvalArgs) -> CmdResult {
     Ok(())
 }
 
+/// The task numbers a run covers: `--tasks`, cut to `--shard` where given (an explicit list,
+/// so a shard's run.json records exactly its tasks and resumes them).
+fn shard_selection(
+    worlds: &[Arc<World>],
+    tasks: &str,
+    shard: Option<verti_bench::shard::Shard>,
+) -> Result<Vec<u32>, verti_bench::eval::EvalError> {
+    let selection = parse_tasks(tasks)?;
+    let Some(shard) = shard else {
+        return Ok(selection);
+    };
+    let all: Vec<u32> = if selection.is_empty() {
+        verti_bench::eval::select_tasks(worlds, &[])?
+            .into_iter()
+            .map(|(wi, pair)| worlds[wi].task_id(pair).number())
+            .collect()
+    } else {
+        selection
+    };
+    let mine = shard.select(&all);
+    if mine.is_empty() {
+        return Err(verti_bench::eval::EvalError::Argument(format!(
+            "--shard {}/{}: no tasks (the selection has only {})",
+            shard.index,
+            shard.count,
+            all.len()
+        )));
+    }
+    Ok(mine)
+}
+
 /// What every system of one `verti eval` shares.
 struct Shared<'a> {
+    selection: &'a [u32],
+    perception: Option<Arc<verti_bench::perception::PerceptionModel>>,
     registry: &'a verti_bench::SystemRegistry,
     worlds: &'a [Arc<World>],
     vehicle: &'a verti_sim::VehicleSpec,
@@ -213,13 +258,14 @@ fn eval_system(
 ) -> Result<Vec<String>, verti_bench::eval::EvalError> {
     let (registry, worlds, vehicle, scale, pb) =
         (sh.registry, sh.worlds, sh.vehicle, sh.scale, sh.pb);
-    let selection = parse_tasks(&a.tasks)?;
+    let selection = sh.selection;
     let jobs = a.jobs.unwrap_or_else(rayon::current_num_threads);
     let episode = EpisodeConfig {
         rules: a.rules,
         max_time: a.max_time,
         seed: a.seed,
         start: a.start,
+        perception: sh.perception.clone(),
         ..Default::default()
     };
     let warn = |m: &str| pb.println(format!("warning: {m}"));
@@ -263,7 +309,7 @@ fn eval_system(
             .expect("the system was built once already")
     };
     let t0 = std::time::Instant::now();
-    let results = evaluate(&setup, &selection, &make, &|_| pb.inc(1))?;
+    let results = evaluate(&setup, selection, &make, &|_| pb.inc(1))?;
     let wall = t0.elapsed().as_secs_f64();
     let count = |o: Outcome| results.iter().filter(|r| r.outcome == o).count();
     let n = results.len().max(1) as f64;

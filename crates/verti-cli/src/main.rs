@@ -13,6 +13,7 @@ mod learn_pietra;
 mod learn_rl;
 #[cfg(feature = "learn")]
 mod learn_va;
+mod merge_cmd;
 mod outputs;
 mod pietra_cmd;
 mod progress;
@@ -49,6 +50,8 @@ enum Command {
     Systems(SystemsCommand),
     /// Evaluate a mobility system on a world set (parallel, resumable).
     Eval(eval_cmd::EvalArgs),
+    /// Join the run directories of a sharded evaluation (`verti eval --shard i/N`) into one.
+    Merge(merge_cmd::MergeArgs),
     /// Draw one evaluated trial's trajectory over its world.
     Replay(eval_cmd::ReplayArgs),
     /// Table I and Fig. 6 (Markdown, HTML, PNG, JSON) from evaluation results.
@@ -99,6 +102,7 @@ fn main() -> ExitCode {
         Command::Sim(cmd) => vehicle_cmd::run_sim(cmd),
         Command::Systems(SystemsCommand::List) => eval_cmd::systems_list(),
         Command::Eval(a) => eval_cmd::eval(a),
+        Command::Merge(a) => merge_cmd::merge(a),
         Command::Replay(a) => eval_cmd::replay(a),
         Command::Report(a) => eval_cmd::report(a),
         Command::Learn(cmd) => learn_cmd::run(cmd).map_err(Into::into),
