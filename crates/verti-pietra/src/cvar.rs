@@ -17,12 +17,14 @@
 use crate::bins::{B, Pmf};
 
 /// Mass of one bin after the "negative or NaN counts as 0" rule.
+#[inline]
 fn mass(p: f64) -> f64 {
     if p > 0.0 { p } else { 0.0 }
 }
 
 /// Mean of the worst α fraction of the mass, visiting bins in `order` (worst first).
 /// `exact` splits the crossing atom; otherwise the whole crossing atom is taken (mppi_numba).
+#[inline]
 fn tail(p: &Pmf, values: &[f64; B], alpha: f64, order: [usize; B], exact: bool) -> f64 {
     let total: f64 = p.iter().map(|&x| mass(x)).sum();
     if !(total > 0.0 && total.is_finite()) {
@@ -60,10 +62,12 @@ fn tail(p: &Pmf, values: &[f64; B], alpha: f64, order: [usize; B], exact: bool) 
     }
 }
 
+#[inline]
 fn ascending() -> [usize; B] {
     std::array::from_fn(|k| k)
 }
 
+#[inline]
 fn descending() -> [usize; B] {
     std::array::from_fn(|k| B - 1 - k)
 }
@@ -72,6 +76,7 @@ fn descending() -> [usize; B] {
 /// atom. With b* = min{b : Σ_{j≤b} p_j ≥ α} it is (1/α)[Σ_{b<b*} p_b v_b + (α − Σ_{b<b*} p_b) v_{b*}].
 /// Used for traction (ψ1, ψ2) in the CVaR dynamics of eq. 4, because low traction is the risk.
 /// See the module docs for the handling of unnormalised PMFs and out-of-range α.
+#[inline]
 pub fn cvar_left(p: &Pmf, values: &[f64; B], alpha: f64) -> f64 {
     tail(p, values, alpha, ascending(), true)
 }
@@ -79,6 +84,7 @@ pub fn cvar_left(p: &Pmf, values: &[f64; B], alpha: f64) -> f64 {
 /// Right-tail CVaR→_α: the mean of the highest α fraction of the mass, exact with a fractional
 /// last atom; equals −CVaR←_α of the negated values. Used for |roll| and |pitch| (ψ3, ψ4) in the
 /// constraints of eq. 5, because large attitude is the risk.
+#[inline]
 pub fn cvar_right(p: &Pmf, values: &[f64; B], alpha: f64) -> f64 {
     tail(p, values, alpha, descending(), true)
 }

@@ -118,27 +118,53 @@ pub fn footprint_cvar(
             (p.pmf, p.log_density < m.card.ood_log_density)
         }
     };
-    let mut out = [0.0; PARAMS];
-    for k in 0..PARAMS {
+    (pmf_cvars(&pmf, spec), ood)
+}
+
+/// The four CVaRs the map stores, of the four PMFs of one footprint.
+pub(crate) fn pmf_cvars(pmf: &[Pmf; PARAMS], spec: &MapSpec) -> [f64; PARAMS] {
+    std::array::from_fn(|k| {
         let v = spec.bins[k].values();
-        out[k] = if k < 2 {
+        if k < 2 {
             cvar_left(&pmf[k], &v, spec.alpha)
         } else {
             cvar_right(&pmf[k], &v, spec.alpha)
-        };
-    }
-    (out, ood)
+        }
+    })
 }
 
 impl CvarMap {
     /// Computes the map of `region` (rows in parallel; the result does not depend on the
-    /// thread count).
+    /// thread count). Many footprints at a time; the values are those of [`footprint_cvar`],
+    /// bit for bit.
     pub fn build(terrain: &Heightfield, spec: &MapSpec, source: Source, region: Region) -> CvarMap {
+        Self::assemble(spec, region, |r| {
+            crate::map_rows::row(terrain, spec, source, region, r)
+        })
+    }
+
+    /// The same map computed one footprint at a time by [`footprint_cvar`]: the reference the
+    /// fast path is tested against.
+    pub fn build_reference(
+        terrain: &Heightfield,
+        spec: &MapSpec,
+        source: Source,
+        region: Region,
+    ) -> CvarMap {
+        Self::assemble(spec, region, |r| {
+            Self::row(terrain, spec, source, region, r)
+        })
+    }
+
+    /// Rows (columns then headings, as [`CvarMap::row`] orders them) into the map's layout.
+    fn assemble(
+        spec: &MapSpec,
+        region: Region,
+        row: impl Fn(usize) -> (Vec<[f64; PARAMS]>, Vec<bool>) + Sync + Send,
+    ) -> CvarMap {
         let plane = region.cells();
-        let rows: Vec<(Vec<[f64; PARAMS]>, Vec<bool>)> = (0..region.rows)
-            .into_par_iter()
-            .map(|r| Self::row(terrain, spec, source, region, r))
-            .collect();
+        let rows: Vec<(Vec<[f64; PARAMS]>, Vec<bool>)> =
+            (0..region.rows).into_par_iter().map(row).collect();
         let mut values = vec![0.0f32; PARAMS * YAWS * plane];
         let mut ood = vec![false; YAWS * plane];
         for (r, (vals, flags)) in rows.into_iter().enumerate() {
@@ -303,5 +329,38 @@ mod tests {
                 Region::around(0.0, 0.0, 1.0, 5, 5)
             )
         );
+    }
+
+    #[test]
+    fn fast_build_equals_one_footprint_at_a_time_bit_for_bit() {
+        // a rough test map, the shipped model and the prior alone; 37 columns: a whole chunk
+        // of the batch path, a part chunk, and footprints reaching past the map's edge
+        let model = crate::shipped::pietra_v1().unwrap();
+        let world = &crate::maps::split_maps(crate::maps::Split::Test)[0];
+        let t = &world.terrain;
+        let half = t.half_extent();
+        for (region, alpha) in [
+            (Region::around(0.0, 0.0, 0.5, 37, 6), 0.5),
+            (Region::around(half - 4.0, 3.0 - half, 0.39, 37, 4), 0.2),
+        ] {
+            let spec = spec(alpha);
+            for source in [Source::Model(&model), Source::Physics] {
+                let fast = CvarMap::build(t, &spec, source, region);
+                let slow = CvarMap::build_reference(t, &spec, source, region);
+                assert_eq!(fast.ood, slow.ood);
+                let bits = |m: &CvarMap| m.values.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&fast), bits(&slow));
+                // and before the f32 store: the f64 values of one row
+                let r = 1;
+                let fast_row = crate::map_rows::row(t, &spec, source, region, r);
+                let slow_row = CvarMap::row(t, &spec, source, region, r);
+                let bits64 = |v: &[[f64; PARAMS]]| {
+                    v.iter()
+                        .flat_map(|a| a.map(f64::to_bits))
+                        .collect::<Vec<_>>()
+                };
+                assert_eq!(bits64(&fast_row.0), bits64(&slow_row.0));
+            }
+        }
     }
 }

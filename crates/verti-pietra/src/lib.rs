@@ -13,11 +13,14 @@
 //! * [`system`]: the `pietra` mobility system;
 //! * [`shipped`]: the trained `pietra-v1`, compiled in.
 
+mod batch_mlp;
 pub mod bins;
 pub mod cvar;
 pub mod cvar_map;
 pub mod dataset;
 pub mod emd;
+mod map_rows;
+mod map_simd;
 pub mod maps;
 pub mod model;
 pub mod planner;

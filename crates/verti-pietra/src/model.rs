@@ -8,6 +8,7 @@
 //! log N)) · sigmoid(scale_k(z)), β_k = n_prior p_prior,k + n_k p_φ,k, and the expected PMF
 //! β_k / Σβ_k (eq. 11). Methods without evidence predict p_φ,k.
 
+use crate::batch_mlp::BatchMlp;
 use crate::bins::{B, Bins, PARAMS, Pmf, uniform};
 use crate::dataset::FEATURES;
 use crate::prior::PriorConfig;
@@ -68,6 +69,7 @@ pub struct TravModel {
     /// Flow parameters after the softplus.
     alpha: Vec<f64>,
     beta: Vec<f64>,
+    batch: Option<Arc<BatchNets>>,
 }
 
 /// Work buffers of one thread.
@@ -76,8 +78,15 @@ pub struct TravScratch {
     mlp: MlpScratch,
     input: Vec<f32>,
     z: Vec<f32>,
-    logits: Vec<f32>,
-    scale: Vec<f32>,
+    flow: Vec<f64>,
+}
+
+/// The six networks in the batch kernel's layout.
+#[derive(Clone, Debug)]
+pub(crate) struct BatchNets {
+    pub encoder: BatchMlp,
+    pub decoders: Vec<BatchMlp>,
+    pub scaler: BatchMlp,
 }
 
 /// What a model says about one footprint.
@@ -89,6 +98,7 @@ pub struct TravPrediction {
     pub log_density: f64,
 }
 
+#[inline]
 fn softplus(x: f64) -> f64 {
     if x > 20.0 { x } else { x.exp().ln_1p() }
 }
@@ -172,7 +182,17 @@ impl TravModel {
             .zip(&alpha)
             .map(|(b, a)| softplus(*b) - a)
             .collect();
+        let batch = (|| {
+            Some(Arc::new(BatchNets {
+                encoder: BatchMlp::new(&networks[0], Some(card.input_scale))?,
+                decoders: (1..=PARAMS)
+                    .map(|k| BatchMlp::new(&networks[k], None))
+                    .collect::<Option<_>>()?,
+                scaler: BatchMlp::new(&networks[1 + PARAMS], None)?,
+            }))
+        })();
         Ok(TravModel {
+            batch,
             card,
             networks,
             encoder,
@@ -229,15 +249,21 @@ impl TravModel {
             mlp: self.encoder.scratch(),
             input: vec![0.0; FEATURES],
             z: vec![0.0; self.card.latent],
-            logits: vec![0.0; B],
-            scale: vec![0.0; PARAMS],
+            flow: Vec::with_capacity(self.card.latent),
         }
     }
 
     /// log p(z) under the radial flow with a standard normal base.
     pub fn log_density(&self, z: &[f32]) -> f64 {
+        self.log_density_in(z, &mut Vec::new())
+    }
+
+    /// [`TravModel::log_density`] with the flow's state in `v` (no allocation once it has grown).
+    #[inline]
+    fn log_density_in(&self, z: &[f32], v: &mut Vec<f64>) -> f64 {
         let h = self.card.latent;
-        let mut v: Vec<f64> = z.iter().map(|x| f64::from(*x)).collect();
+        v.clear();
+        v.extend(z.iter().map(|x| f64::from(*x)));
         let mut log_det = 0.0;
         for l in 0..self.alpha.len() {
             let z0 = &self.card.flow_z0[l * h..(l + 1) * h];
@@ -269,15 +295,43 @@ impl TravModel {
         physics: &[Pmf; PARAMS],
         s: &mut TravScratch,
     ) -> TravPrediction {
-        let c = &self.card;
         s.input.copy_from_slice(features);
         self.encoder.forward_into(&s.input, &mut s.mlp, &mut s.z);
+        let mut logits = [[0.0f32; B]; PARAMS];
+        for (dec, l) in self.decoders.iter().zip(&mut logits) {
+            dec.forward_into(&s.z, &mut s.mlp, l);
+        }
+        let mut scale = [0.0f32; PARAMS];
+        if self.card.evidential && self.card.scales_evidence {
+            self.scaler.forward_into(&s.z, &mut s.mlp, &mut scale);
+        }
+        self.finish(&s.z, &logits, &scale, physics, &mut s.flow)
+    }
+
+    /// The networks laid out for many footprints at once, if every one is an MLP the batch
+    /// kernel runs.
+    pub(crate) fn batch(&self) -> Option<&BatchNets> {
+        self.batch.as_deref()
+    }
+
+    /// What follows the networks: the decoders' softmax, the flow's density, the evidence and
+    /// the posterior's expected PMF (eq. 11), from the latent `z`, the decoders' `logits` and
+    /// the scaler's outputs (read only when the card scales evidence). `flow` is work space.
+    #[inline]
+    pub(crate) fn finish(
+        &self,
+        z: &[f32],
+        logits: &[[f32; B]; PARAMS],
+        scale: &[f32; PARAMS],
+        physics: &[Pmf; PARAMS],
+        flow: &mut Vec<f64>,
+    ) -> TravPrediction {
+        let c = &self.card;
         let mut learned = [[0.0; B]; PARAMS];
-        for (k, dec) in self.decoders.iter().enumerate() {
-            dec.forward_into(&s.z, &mut s.mlp, &mut s.logits);
-            let max = s.logits.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        for (k, logits) in logits.iter().enumerate() {
+            let max = logits.iter().copied().fold(f32::NEG_INFINITY, f32::max);
             let mut sum = 0.0;
-            for (p, l) in learned[k].iter_mut().zip(&s.logits) {
+            for (p, l) in learned[k].iter_mut().zip(logits) {
                 *p = f64::from(l - max).exp();
                 sum += *p;
             }
@@ -289,18 +343,15 @@ impl TravModel {
                 log_density: f64::NAN,
             };
         }
-        let log_density = self.log_density(&s.z);
+        let log_density = self.log_density_in(z, flow);
         let log_n = (log_density + c.log_budget).clamp(-c.log_evidence_clamp, c.log_evidence_clamp);
-        if c.scales_evidence {
-            self.scaler.forward_into(&s.z, &mut s.mlp, &mut s.scale);
-        }
         let u = uniform();
         let mut pmf = [[0.0; B]; PARAMS];
         for k in 0..PARAMS {
             let mut ln = log_n;
             if c.scales_evidence {
                 // log sigmoid, stable for any sign
-                let x = f64::from(s.scale[k]);
+                let x = f64::from(scale[k]);
                 ln += -softplus(-x);
             }
             let n = ln.exp();

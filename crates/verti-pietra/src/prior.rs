@@ -67,6 +67,7 @@ impl Default for PriorConfig {
 }
 
 /// `x` clipped to [0, 1], with NaN mapped to `nan_as`, so every caller states its NaN policy.
+#[inline(always)]
 fn unit(x: f64, nan_as: f64) -> f64 {
     if x.is_nan() {
         nan_as
@@ -77,6 +78,7 @@ fn unit(x: f64, nan_as: f64) -> f64 {
 
 /// One-hot traction PMFs of four wheels, ¼ each, from a per-wheel "how far to the limit" value.
 /// A NaN traction (bad measurement, or a non-positive limit) is taken as 0, the pessimistic end.
+#[inline(always)]
 fn wheel_traction(quantity: &[f64; 4], limit: f64, bins: &Bins) -> Pmf {
     let mut p = [0.0; B];
     for &q in quantity {
@@ -89,6 +91,7 @@ fn wheel_traction(quantity: &[f64; 4], limit: f64, bins: &Bins) -> Pmf {
 /// Dirt traction prior of eq. 15: each wheel contributes ¼ on the bin of
 /// clip((s_max − |s_i|)/s_max, 0, 1), i.e. traction falls linearly with the slope along the
 /// heading. NaN slopes, or s_max ≤ 0, give traction 0 (the pessimistic end).
+#[inline(always)]
 pub fn dirt_traction(slopes: &[f64; 4], max_slope: f64, bins: &Bins) -> Pmf {
     wheel_traction(&slopes.map(f64::abs), max_slope, bins)
 }
@@ -96,6 +99,7 @@ pub fn dirt_traction(slopes: &[f64; 4], max_slope: f64, bins: &Bins) -> Pmf {
 /// Vegetation traction prior of eq. 16: each wheel contributes ¼ on the bin of
 /// clip((h_max − h_i)/h_max, 0, 1), since taller vegetation slows the robot more. NaN heights,
 /// or h_max ≤ 0, give traction 0.
+#[inline(always)]
 pub fn vegetation_traction(vegetation: &[f64; 4], max_height: f64, bins: &Bins) -> Pmf {
     wheel_traction(vegetation, max_height, bins)
 }
@@ -103,6 +107,7 @@ pub fn vegetation_traction(vegetation: &[f64; 4], max_height: f64, bins: &Bins) 
 /// Roll or pitch prior of eq. 17: each wheel pair contributes ½ on the bin of
 /// |atan((h_i − h_j)/d)| (absolute, since ψ3, ψ4 ≥ 0). A NaN angle (NaN height, or 0/0 with
 /// d = 0) goes to the last bin: unlike traction, the pessimistic end of attitude is the top.
+#[inline(always)]
 pub fn attitude_prior(
     heights: &[f64; 4],
     pairs: &[(usize, usize); 2],
@@ -129,6 +134,7 @@ pub fn attitude_prior(
 ///
 /// Every output sums to 1 whatever the input: `veg_fraction` and `w_uniform` are clipped to
 /// [0, 1]; a NaN `veg_fraction` counts as 0 (dirt) and a NaN `w_uniform` as 1 (all uniform).
+#[inline(always)]
 pub fn physics_prior(fp: &Footprint, cfg: &PriorConfig, bins: &[Bins; PARAMS]) -> [Pmf; PARAMS] {
     let r_veg = unit(fp.veg_fraction, 0.0);
     let r_dirt = 1.0 - r_veg;
