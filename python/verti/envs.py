@@ -128,6 +128,7 @@ def _settings(
     occupancy,
     reward,
     state_features=None,
+    perception=None,
 ) -> Dict[str, Any]:
     weights = reward if isinstance(reward, dict) else None
     if reward is not None and weights is None and not callable(reward):
@@ -149,6 +150,7 @@ def _settings(
         occupancy=occupancy,
         reward_weights=weights,
         state_features=None if state_features is None else list(state_features),
+        perception=None if perception is None else str(perception),
     )
 
 
@@ -197,6 +199,8 @@ class NavigateEnv(gym.Env):
         reward: None (default reward), a dict of its weights, or a callable.
         state_features: names of the state vector's entries (default ``verti.STATE_FIELDS``;
             every feature with its unit is in ``verti.FEATURES``).
+        perception: perception noise on what the agent observes (never on the physics):
+            None or ``"none"`` (ground truth), ``"low"``, ``"medium"``, ``"high"``, or a YAML file.
         render_mode: None or ``"rgb_array"`` (top view with the task, trail and vehicle).
         render_pixels_per_cell: render resolution (4 gives 516 x 516 for a full world).
     """
@@ -225,6 +229,7 @@ class NavigateEnv(gym.Env):
         occupancy=None,
         reward: RewardArg = None,
         state_features: Optional[Sequence[str]] = None,
+        perception: Optional[str] = None,
         render_mode: Optional[str] = None,
         render_pixels_per_cell: int = 4,
     ):
@@ -247,6 +252,7 @@ class NavigateEnv(gym.Env):
             occupancy=occupancy,
             reward=reward,
             state_features=state_features,
+            perception=perception,
         )
         self._core = EnvCore(_resolve_worlds(world, scale), vehicle, **settings)
         self._reward_fn = reward if callable(reward) else None
@@ -343,6 +349,7 @@ class NavigateVectorEnv(VectorEnv):
         occupancy=None,
         reward: RewardArg = None,
         state_features: Optional[Sequence[str]] = None,
+        perception: Optional[str] = None,
         render_mode: Optional[str] = None,
         render_pixels_per_cell: int = 4,
     ):
@@ -366,6 +373,7 @@ class NavigateVectorEnv(VectorEnv):
             occupancy=occupancy,
             reward=reward,
             state_features=state_features,
+            perception=perception,
         )
         self._core = VecEnvCore(int(num_envs), _resolve_worlds(world, scale), vehicle, num_threads, **settings)
         self._reward_fn = reward if callable(reward) else None

@@ -374,6 +374,20 @@ pub fn run_episode(
     cfg: &EpisodeConfig,
     log: Option<&mut EpisodeLog>,
 ) -> TrialResult {
+    run_episode_watched(world, spec, pair, system, cfg, log, &mut |_| {})
+}
+
+/// [`run_episode`], showing `watch` the trial at its start and after every control period
+/// (3-D recordings, live views). Watching changes nothing: the result is the same bits.
+pub fn run_episode_watched(
+    world: &Arc<World>,
+    spec: &VehicleSpec,
+    pair: u32,
+    system: &mut dyn MobilitySystem,
+    cfg: &EpisodeConfig,
+    log: Option<&mut EpisodeLog>,
+    watch: &mut dyn FnMut(&Trial),
+) -> TrialResult {
     let wall = Instant::now();
     let name = system.name().to_string();
     let cfg = match (&log, cfg.log_seconds) {
@@ -404,13 +418,16 @@ pub fn run_episode(
         ));
     }
     let period = 1.0 / rate;
+    watch(&trial);
     loop {
         let action = system.act(&trial.observation());
         if let Some(message) = system.failure() {
             trial.abort(format!("system {name} failed: {message}"));
             break;
         }
-        if trial.step(action, period).ended.is_some() {
+        let ended = trial.step(action, period).ended.is_some();
+        watch(&trial);
+        if ended {
             break;
         }
     }

@@ -34,6 +34,7 @@ pub mod trial;
 
 pub use episode::{
     EpisodeConfig, Outcome, Rules, StartMode, Termination, TrialResult, run_episode,
+    run_episode_watched,
 };
 pub use features::{Feature, FeatureSource};
 pub use observation::{Crop, CropSpec, Observation};

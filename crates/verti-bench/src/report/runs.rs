@@ -44,6 +44,18 @@ fn settings(r: &RunRecord) -> BTreeMap<String, String> {
     put("seed", run.seed.to_string());
     put("max_time", run.max_time.to_string());
     put("start", r.start.name().to_string());
+    // a run without perception noise has no entry, so older runs group as before
+    if let Some(p) = &r.perception {
+        // a preset by its name; a custom model by name and content (two files of one name
+        // with different noise are two runs)
+        let value = if crate::perception::PerceptionModel::preset(&p.name).as_ref() == Some(p) {
+            p.name.clone()
+        } else {
+            let hex = verti_core::digest::Digest::new().debug(p).hex();
+            format!("{}#{}", p.name, &hex[..8.min(hex.len())])
+        };
+        put("perception", value);
+    }
     for (k, v) in run.params.iter() {
         put(k, v.to_string());
     }

@@ -92,7 +92,8 @@ pub(super) fn env_core(
     vehicle: Option<&str>,
     settings: &Bound<'_, PyDict>,
 ) -> PyResult<EnvCore> {
-    const KNOWN: [&str; 18] = [
+    const KNOWN: [&str; 19] = [
+        "perception",
         "scale",
         "control_rate",
         "action_mode",
@@ -154,6 +155,12 @@ pub(super) fn env_core(
     cfg.episode.inner_dt = f("inner_dt", cfg.episode.inner_dt)?;
     if let Some(r) = get("rules")? {
         cfg.episode.rules = parse_rules(&r.extract::<String>()?)?;
+    }
+    if let Some(p) = get("perception")? {
+        let spec: String = p
+            .extract()
+            .map_err(|_| PyTypeError::new_err("perception must be a preset name or a YAML path"))?;
+        cfg.episode.perception = super::eval::perception_arg(&spec)?;
     }
     if let Some(a) = get("action_mode")? {
         cfg.action = match a.extract::<String>()?.as_str() {

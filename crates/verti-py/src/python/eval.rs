@@ -193,7 +193,7 @@ pub(super) fn params_arg(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String
 /// (default `pid`) or a Python object with `reset(task)` and `act(obs)` (see `pysystem`), which
 /// runs one trial at a time through the same trial code.
 #[pyfunction]
-#[pyo3(signature = (system = None, worlds = None, tasks = None, jobs = None, *, vehicle = None, params = None, rules = "paper", max_time = 60.0, seed = 0, scale = None, start = "settled", out = None, resume = false, force = false))]
+#[pyo3(signature = (system = None, worlds = None, tasks = None, jobs = None, *, vehicle = None, params = None, rules = "paper", max_time = 60.0, seed = 0, scale = None, start = "settled", out = None, resume = false, force = false, perception = "none"))]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn evaluate(
     py: Python<'_>,
@@ -211,6 +211,7 @@ pub(super) fn evaluate(
     out: Option<PathBuf>,
     resume: bool,
     force: bool,
+    perception: &str,
 ) -> PyResult<Vec<Py<PyAny>>> {
     let default = PyString::new(py, "pid");
     let system = match system {
@@ -239,6 +240,7 @@ pub(super) fn evaluate(
         out,
         resume,
         force,
+        perception,
     };
     if !system.is_instance_of::<PyString>() {
         return evaluate_object(py, system, params, setup);
@@ -384,6 +386,8 @@ pub(super) struct EvalArgs<'a, 'py> {
     out: Option<PathBuf>,
     resume: bool,
     force: bool,
+    /// A perception preset or YAML file (`none`: ground truth).
+    perception: &'a str,
 }
 
 /// What every evaluation resolves first: the vehicle, the worlds, the selected tasks and the
@@ -394,6 +398,15 @@ struct Prepared {
     worlds_name: String,
     selected: Vec<(usize, u32)>,
     episode: EpisodeConfig,
+}
+
+/// A perception preset or YAML file; None for ground truth.
+pub(super) fn perception_arg(
+    spec: &str,
+) -> PyResult<Option<Arc<verti_bench::perception::PerceptionModel>>> {
+    let m = verti_bench::perception::PerceptionModel::load(spec)
+        .map_err(|e| value_err(format!("perception: {e}")))?;
+    Ok((!m.is_none()).then(|| Arc::new(m)))
 }
 
 fn prepare(py: Python<'_>, a: &EvalArgs<'_, '_>) -> PyResult<Prepared> {
@@ -425,6 +438,7 @@ fn prepare(py: Python<'_>, a: &EvalArgs<'_, '_>) -> PyResult<Prepared> {
         max_time: a.max_time,
         seed: a.seed,
         start,
+        perception: perception_arg(a.perception)?,
         ..Default::default()
     };
     episode.validate().map_err(value_err)?;
