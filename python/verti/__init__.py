@@ -8,7 +8,8 @@ vehicle simulator, parallel evaluation of mobility systems, and gymnasium enviro
 >>> sim = verti.Sim(world, "hmmwv", start=0)               # at the start of pair 0
 >>> sim.step(throttle=0.5, brake=0.0, steering=0.1)        # 10 ms of driving
 >>> env = gym.make("verti/Navigate-v0", world=world)       # registered on import
->>> results = verti.evaluate("pid", "verti-100", tasks="1-10")  # list of dicts
+>>> results = verti.evaluate("pid", "verti-100", tasks="1-10", out="runs/pid")  # list of dicts
+>>> verti.replay("runs/pid", task=3, out="task3.html")     # a 3-D page of one trial
 
 Long calls release the GIL and stop on Ctrl-C; Rust errors arrive as ValueError,
 FileNotFoundError/OSError or verti.SimulationError with the Rust message.
@@ -28,6 +29,7 @@ from ._verti import (
     __version__,
     evaluate,
     load_worlds,
+    replay,
     systems,
     vehicles,
 )
@@ -56,6 +58,7 @@ __all__ = [
     "flatten_result",
     "load_worlds",
     "register_envs",
+    "replay",
     "results_table",
     "systems",
     "to_dataframe",

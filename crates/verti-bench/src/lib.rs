@@ -26,6 +26,7 @@ pub mod metrics;
 pub mod observation;
 pub mod path;
 pub mod perception;
+pub mod replay;
 pub mod report;
 pub mod shard;
 pub mod speed;

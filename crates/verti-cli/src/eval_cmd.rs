@@ -7,8 +7,7 @@ use clap::Args;
 use std::path::PathBuf;
 use std::sync::Arc;
 use verti_bench::episode::{EpisodeLog, Outcome, Rules, StartMode};
-use verti_bench::eval::{EvalSetup, RUN_FILE, RunInfo, evaluate, parse_tasks, read_results};
-use verti_bench::identity::RunRecord;
+use verti_bench::eval::{EvalSetup, RunInfo, evaluate, parse_tasks};
 use verti_bench::{EpisodeConfig, run_episode};
 use verti_world::World;
 
@@ -356,9 +355,13 @@ pub struct ReplayArgs {
     /// Task number to replay.
     #[arg(long)]
     task: u32,
-    /// Output PNG.
+    /// Output: a PNG (top view), or with --3d an HTML page.
     #[arg(long)]
     out: PathBuf,
+    /// A 3-D recording instead: one self-contained HTML page (WebGL, no server) with the
+    /// terrain, obstacles, vehicle body and wheels, path, trail and time series.
+    #[arg(long = "3d")]
+    three_d: bool,
     /// Pixels per heightfield cell.
     #[arg(long, default_value_t = 4)]
     px_per_cell: u32,
@@ -367,78 +370,61 @@ pub struct ReplayArgs {
 /// Re-runs one task of an evaluation (trials are deterministic) with a per-step log and draws
 /// its trajectory over the world, coloured by speed, with the failure point marked.
 pub fn replay(a: ReplayArgs) -> CmdResult {
-    let run_path = a.result.join(RUN_FILE);
-    let record = RunRecord::read(&run_path)?;
-    let run = &record.run;
-    let (results, _) = read_results(&a.result.join(verti_bench::eval::RESULTS_FILE))?;
-    let recorded = results.iter().find(|r| r.task == a.task).ok_or_else(|| {
-        format!(
-            "task {} is not in {} ({} results)",
+    let registry = crate::registries::systems();
+    let by_name = |name: &str| load_vehicle(name).map_err(|e| e.to_string());
+    let mut setup = verti_bench::replay::prepare(&a.result, a.task, &registry, &by_name)?;
+    let (world, vehicle, pair) = (setup.world.clone(), setup.vehicle.clone(), setup.pair);
+    let html = a.out.extension().and_then(|e| e.to_str()) == Some("html");
+    if !a.three_d && html {
+        return Err(format!(
+            "--out {}: an HTML page is a 3-D replay: pass --3d (or name the picture .png)",
+            a.out.display()
+        )
+        .into());
+    }
+    if a.three_d {
+        if !html {
+            return Err(format!(
+                "--out {}: a 3-D replay is an HTML page; name it .html",
+                a.out.display()
+            )
+            .into());
+        }
+        verti_core::output::check_output_file(&a.out, &["html"])
+            .map_err(|problem| format!("{}: {problem}", a.out.display()))?;
+        let (recording, replayed) =
+            verti_view::record_trial(&world, &vehicle, pair, setup.system.as_mut(), &setup.cfg);
+        if let Some(w) = setup.mismatch(&replayed) {
+            eprintln!("warning: {w}");
+        }
+        verti_view::write_html(&recording, &a.out)
+            .map_err(|e| format!("{}: {e}", a.out.display()))?;
+        println!(
+            "task {} ({} pair {pair}): {} after {:.1} s; {} frames in {} (open it in a browser)",
             a.task,
-            a.result.display(),
-            results.len()
-        )
-    })?;
-    let vehicle = match &record.vehicle_spec {
-        Some(spec) => spec.clone(),
-        None => load_vehicle(&run.vehicle)?,
-    };
-    if let Some(d) = &record.vehicle_digest
-        && *d != verti_bench::identity::vehicle_digest(&vehicle)
-    {
-        return Err(format!(
-            "{}: vehicle `{}` is not the one the run drove (its contents changed since)",
-            run_path.display(),
-            run.vehicle
-        )
-        .into());
+            world.meta.name,
+            replayed.outcome.name(),
+            replayed.time,
+            recording.frames.len(),
+            a.out.display()
+        );
+        return Ok(());
     }
-    let id = verti_world::TaskId::from_number(a.task).ok_or("task numbers start at 1")?;
-    // the whole set, to check by content that it is still the set the run used
-    let set: Vec<Arc<World>> = verti_world::sets::resolve_set(&run.worlds, run.scale, &|| {})
-        .map_err(|e| format!("the run's world set `{}`: {e}", run.worlds))?
-        .worlds
-        .into_iter()
-        .map(Arc::new)
-        .collect();
-    if let Some(d) = &record.worlds_digest
-        && *d != verti_bench::identity::set_digest(&set)
-    {
-        return Err(format!(
-            "`{}` no longer holds the worlds the run in {} used (their contents differ); run `verti replay` where the run was made, or restore the set",
-            run.worlds,
-            a.result.display()
-        )
-        .into());
-    }
-    let world = set
-        .iter()
-        .find(|w| w.meta.index == id.world)
-        .cloned()
-        .ok_or_else(|| format!("`{}` has no world {}", run.worlds, id.world))?;
-    let mut system = crate::registries::systems().build(&run.system, &run.params)?;
     let cfg = EpisodeConfig {
-        rules: run.rules,
-        max_time: run.max_time,
-        seed: run.seed,
-        start: record.start,
         log_seconds: Some(f64::INFINITY),
-        ..Default::default()
+        ..setup.cfg.clone()
     };
     let mut log = EpisodeLog::default();
     let replayed = run_episode(
         &world,
         &vehicle,
-        id.pair,
-        system.as_mut(),
+        pair,
+        setup.system.as_mut(),
         &cfg,
         Some(&mut log),
     );
-    if replayed.outcome != recorded.outcome || (replayed.time - recorded.time).abs() > 1e-9 {
-        eprintln!(
-            "warning: the replay ended differently ({:?} at {:.2} s) from the recorded trial ({:?} at {:.2} s)",
-            replayed.outcome, replayed.time, recorded.outcome, recorded.time
-        );
+    if let Some(w) = setup.mismatch(&replayed) {
+        eprintln!("warning: {w}");
     }
     use verti_bench::features::Feature;
     let value = |s: &verti_bench::episode::StepRecord, f: Feature| s.get(f).unwrap_or(f64::NAN);
@@ -461,7 +447,7 @@ pub fn replay(a: ReplayArgs) -> CmdResult {
         .collect();
     let options = verti_render::RenderOptions {
         pixels_per_cell: a.px_per_cell,
-        pairs: Some(vec![id.pair]),
+        pairs: Some(vec![pair]),
         ..Default::default()
     };
     let mut img = verti_render::render_world(&world, &options)?;
@@ -476,10 +462,9 @@ pub fn replay(a: ReplayArgs) -> CmdResult {
     ensure_parent(&a.out)?;
     img.save_png(&a.out)?;
     println!(
-        "task {} ({} pair {}): {} after {:.1} s, {:.1} m driven; trajectory written to {}",
+        "task {} ({} pair {pair}): {} after {:.1} s, {:.1} m driven; trajectory written to {}",
         a.task,
         world.meta.name,
-        id.pair,
         replayed.outcome.name(),
         replayed.time,
         replayed.path_length,

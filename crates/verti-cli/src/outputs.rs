@@ -13,6 +13,13 @@ pub fn png_file(text: &str) -> Result<PathBuf, String> {
     Ok(path)
 }
 
+/// A replay's output: a `.png` picture or a `.html` 3-D page, in an existing directory.
+pub fn replay_file(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    check_output_file(&path, &["png", "html"])?;
+    Ok(path)
+}
+
 /// A directory to write into: an existing one, or a new one inside an existing directory.
 pub fn out_dir(text: &str) -> Result<PathBuf, String> {
     let path = PathBuf::from(text);
@@ -25,7 +32,9 @@ pub fn out_dir(text: &str) -> Result<PathBuf, String> {
 /// place).
 pub fn check_outputs(cli: Command) -> Command {
     cli.mut_subcommand("eval", |c| c.mut_arg("out", |a| a.value_parser(out_dir)))
-        .mut_subcommand("replay", |c| c.mut_arg("out", |a| a.value_parser(png_file)))
+        .mut_subcommand("replay", |c| {
+            c.mut_arg("out", |a| a.value_parser(replay_file))
+        })
         .mut_subcommand("report", |c| c.mut_arg("out", |a| a.value_parser(out_dir)))
 }
 

@@ -1,0 +1,119 @@
+//! Replaying one evaluated trial: everything a replay needs, resolved from a run directory
+//! and checked to be what the run used (trials are deterministic, so re-running the task with
+//! the recorded settings is the trial).
+
+use crate::episode::{EpisodeConfig, TrialResult};
+use crate::eval::{RESULTS_FILE, RUN_FILE, read_results};
+use crate::identity::RunRecord;
+use crate::system::{MobilitySystem, SystemRegistry};
+use std::path::Path;
+use std::sync::Arc;
+use verti_sim::VehicleSpec;
+use verti_world::{TaskId, World};
+
+/// One trial of a run, ready to be driven again.
+pub struct ReplaySetup {
+    pub world: Arc<World>,
+    pub vehicle: VehicleSpec,
+    pub pair: u32,
+    pub system: Box<dyn MobilitySystem>,
+    /// The run's settings (rules, limit, seed, start, perception), no step log.
+    pub cfg: EpisodeConfig,
+    /// The trial as the run recorded it.
+    pub recorded: TrialResult,
+}
+
+impl ReplaySetup {
+    /// A warning when `replayed` ended otherwise than the recorded trial (a changed system or
+    /// engine since the run).
+    pub fn mismatch(&self, replayed: &TrialResult) -> Option<String> {
+        let r = &self.recorded;
+        (replayed.outcome != r.outcome || (replayed.time - r.time).abs() > 1e-9).then(|| {
+            format!(
+                "the replay ended differently ({:?} at {:.2} s) from the recorded trial ({:?} at {:.2} s)",
+                replayed.outcome, replayed.time, r.outcome, r.time
+            )
+        })
+    }
+}
+
+/// Reads `dir/run.json` and the result of `task`, and rebuilds its world (from the run's set,
+/// checked by content), vehicle (the recorded spec, checked by digest) and system (from
+/// `registry` with the recorded parameters). `vehicle_by_name` loads a vehicle for runs
+/// recorded before specs were kept.
+pub fn prepare(
+    dir: &Path,
+    task: u32,
+    registry: &SystemRegistry,
+    vehicle_by_name: &dyn Fn(&str) -> Result<VehicleSpec, String>,
+) -> Result<ReplaySetup, String> {
+    let run_path = dir.join(RUN_FILE);
+    let record = RunRecord::read(&run_path).map_err(|e| e.to_string())?;
+    let run = &record.run;
+    let (results, _) = read_results(&dir.join(RESULTS_FILE)).map_err(|e| e.to_string())?;
+    let recorded = results
+        .iter()
+        .find(|r| r.task == task)
+        .cloned()
+        .ok_or_else(|| {
+            format!(
+                "task {task} is not in {} ({} results)",
+                dir.display(),
+                results.len()
+            )
+        })?;
+    let vehicle = match &record.vehicle_spec {
+        Some(spec) => spec.clone(),
+        None => vehicle_by_name(&run.vehicle)?,
+    };
+    if let Some(d) = &record.vehicle_digest
+        && *d != crate::identity::vehicle_digest(&vehicle)
+    {
+        return Err(format!(
+            "{}: vehicle `{}` is not the one the run drove (its contents changed since)",
+            run_path.display(),
+            run.vehicle
+        ));
+    }
+    let id = TaskId::from_number(task).ok_or("task numbers start at 1")?;
+    // the whole set, to check by content that it is still the set the run used
+    let set: Vec<Arc<World>> = verti_world::sets::resolve_set(&run.worlds, run.scale, &|| {})
+        .map_err(|e| format!("the run's world set `{}`: {e}", run.worlds))?
+        .worlds
+        .into_iter()
+        .map(Arc::new)
+        .collect();
+    if let Some(d) = &record.worlds_digest
+        && *d != crate::identity::set_digest(&set)
+    {
+        return Err(format!(
+            "`{}` no longer holds the worlds the run in {} used (their contents differ); replay where the run was made, or restore the set",
+            run.worlds,
+            dir.display()
+        ));
+    }
+    let world = set
+        .iter()
+        .find(|w| w.meta.index == id.world)
+        .cloned()
+        .ok_or_else(|| format!("`{}` has no world {}", run.worlds, id.world))?;
+    let system = registry
+        .build(&run.system, &run.params)
+        .map_err(|e| e.to_string())?;
+    let cfg = EpisodeConfig {
+        rules: run.rules,
+        max_time: run.max_time,
+        seed: run.seed,
+        start: record.start,
+        perception: record.perception.clone().map(Arc::new),
+        ..Default::default()
+    };
+    Ok(ReplaySetup {
+        world,
+        vehicle,
+        pair: id.pair,
+        system,
+        cfg,
+        recorded,
+    })
+}

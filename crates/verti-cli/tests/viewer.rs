@@ -1,0 +1,137 @@
+//! `verti replay --3d` opened in a real headless browser (Chromium, software WebGL): the page
+//! draws the scene and the time series. Skipped, saying so, where no Chromium is installed
+//! (CI installs Debian's `chromium`; `VERTI_CHROMIUM` names another binary).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn chromium() -> Option<PathBuf> {
+    if let Ok(p) = std::env::var("VERTI_CHROMIUM") {
+        return Some(PathBuf::from(p));
+    }
+    [
+        "/usr/bin/chromium",
+        "/usr/bin/chromium-browser",
+        "/usr/bin/google-chrome",
+    ]
+    .iter()
+    .map(PathBuf::from)
+    .find(|p| p.exists())
+}
+
+fn verti(args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_verti"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "verti {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn screenshot(browser: &Path, page: &Path, png: &Path, profile: &Path) {
+    let url = format!("file://{}#t=0.5", page.display());
+    let out = Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--use-angle=swiftshader",
+            "--enable-unsafe-swiftshader",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--no-first-run",
+            "--hide-scrollbars",
+            "--window-size=1000,700",
+            "--virtual-time-budget=5000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(format!("--screenshot={}", png.display()))
+        .arg(url)
+        .output()
+        .unwrap();
+    assert!(
+        png.exists(),
+        "no screenshot: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn the_3d_page_draws_in_a_headless_browser() {
+    let Some(browser) = chromium() else {
+        eprintln!("skipped: no Chromium (install Debian's chromium, or set VERTI_CHROMIUM)");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("verti-viewer-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = dir.join("run");
+    let page = dir.join("task.html");
+    let png = dir.join("shot.png");
+    verti(&[
+        "eval",
+        "--system",
+        "pid",
+        "--worlds",
+        "verti-4",
+        "--tasks",
+        "1",
+        "--out",
+        run.to_str().unwrap(),
+    ]);
+    verti(&[
+        "replay",
+        run.to_str().unwrap(),
+        "--task",
+        "1",
+        "--3d",
+        "--out",
+        page.to_str().unwrap(),
+    ]);
+    screenshot(&browser, &page, &png, &dir.join("profile"));
+    let img = image::open(&png).unwrap().to_rgb8();
+    let (w, h) = img.dimensions();
+    assert_eq!((w, h), (1000, 700));
+    // the 3-D view is the top of the window (all but the 190-px panel): WebGL drew the
+    // terrain over most of it — pixels far from both the GL clear colour (28, 33, 38) and the
+    // page background (29, 34, 39), which is all a page without WebGL would show there
+    let dark = |p: [u8; 3]| {
+        [[28u8, 33, 38], [29, 34, 39]]
+            .iter()
+            .any(|c| (0..3).map(|i| u32::from(p[i].abs_diff(c[i]))).sum::<u32>() < 24)
+    };
+    let view_h = h - 190;
+    let mut drawn = 0usize;
+    let mut colours = std::collections::HashSet::new();
+    for y in 0..view_h {
+        for x in 0..w {
+            let p = img.get_pixel(x, y).0;
+            if !dark(p) {
+                drawn += 1;
+                colours.insert(p);
+            }
+        }
+    }
+    let share = drawn as f64 / (w * view_h) as f64;
+    assert!(
+        share > 0.5,
+        "only {:.0} % of the 3-D view drawn",
+        100.0 * share
+    );
+    // shading and class colours: a lit scene, not a flat fill
+    assert!(colours.len() > 500, "{} colours", colours.len());
+    // the chart panel has its curves: pixels of the speed series' colour (#58b4ff)
+    let speed_pixels = (view_h + 40..h)
+        .flat_map(|y| (0..w / 4).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let p = img.get_pixel(x, y).0;
+            p[0].abs_diff(0x58) < 40 && p[1].abs_diff(0xb4) < 40 && p[2].abs_diff(0xff) < 40
+        })
+        .count();
+    assert!(speed_pixels > 50, "{speed_pixels} speed-curve pixels");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,44 @@
+//! `verti.replay`: one evaluated trial as a 3-D page (the same as `verti replay --3d`).
+
+use super::*;
+
+/// Re-runs task `task` of the run in directory `run` (written by `verti eval` or
+/// `verti.evaluate(..., out=...)`) and writes its 3-D recording to `out`, a self-contained
+/// HTML page (terrain, obstacles, vehicle body and wheels, path, trail, time series). Returns
+/// the replayed trial's result dict; warns if it ended otherwise than the recorded one.
+#[pyfunction]
+#[pyo3(signature = (run, task, out))]
+pub(super) fn replay(py: Python<'_>, run: PathBuf, task: u32, out: PathBuf) -> PyResult<Py<PyAny>> {
+    if out.extension().and_then(|e| e.to_str()) != Some("html") {
+        return Err(value_err(format!(
+            "out {}: a 3-D replay is an HTML page; name it .html",
+            out.display()
+        )));
+    }
+    verti_core::output::check_output_file(&out, &["html"])
+        .map_err(|p| value_err(format!("{}: {p}", out.display())))?;
+    let registry = system_registry();
+    let by_name = |name: &str| vehicle_spec(name).map_err(|e| e.to_string());
+    let mut setup =
+        verti_bench::replay::prepare(&run, task, &registry, &by_name).map_err(value_err)?;
+    let cancel = AtomicBool::new(false);
+    let (recording, replayed) = interruptible(py, &cancel, || {
+        verti_view::record_trial(
+            &setup.world,
+            &setup.vehicle,
+            setup.pair,
+            setup.system.as_mut(),
+            &setup.cfg,
+        )
+    })?;
+    if let Some(w) = setup.mismatch(&replayed) {
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        let text = std::ffi::CString::new(w.replace('\0', " ")).expect("no NUL left");
+        PyErr::warn(py, &category, &text, 1)?;
+    }
+    verti_view::write_html(&recording, &out)
+        .map_err(|e| PyOSError::new_err(format!("{}: {e}", out.display())))?;
+    results_to_py(py, &[replayed])?
+        .pop()
+        .ok_or_else(|| PyRuntimeError::new_err("no result"))
+}
