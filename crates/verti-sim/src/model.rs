@@ -12,7 +12,7 @@
 //! chassis. This is the exact mass matrix of that system when every suspension axis is the
 //! chassis z axis, which is how vehicles are described here.
 
-use crate::spec::{Differential, VehicleSpec};
+use crate::spec::{Differential, SolidAxleSpec, VehicleSpec};
 use verti_core::Vec3;
 
 /// Standard gravity \[m/s²\] (Chrono: 9.81 along −Z).
@@ -48,6 +48,18 @@ pub(crate) struct WheelModel {
     pub nominal_load: f64,
     /// Static compression of the spring with the vehicle at rest (see [`static_compressions`]).
     pub static_compression: f64,
+    /// On a solid axle: the wheel at the beam's other end and how its travel loads this one.
+    /// `spring` and `damper` above are then the self terms (see [`crate::spec::SolidAxleSpec`]).
+    pub solid: Option<SolidCoupling>,
+}
+
+/// The coupling of a wheel to the other end of its solid axle: the suspension force on this
+/// wheel gains `spring_cross`·s_other + `damper_cross`·ṡ_other.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SolidCoupling {
+    pub partner: usize,
+    pub spring_cross: f64,
+    pub damper_cross: f64,
 }
 
 /// Wheels that share one spin degree of freedom (a track's side, or a locked differential).
@@ -153,6 +165,21 @@ impl Model {
                     groups[g].inertia / groups[g].wheels.len() as f64 / ax.wheel.radius.powi(2);
                 let lat_mass = total_mass / spec.wheel_count() as f64;
                 let stop_damping = 2.0 * 0.5 * (ax.suspension.stop_stiffness * mu).sqrt();
+                let (rate_k, rate_c) = (ax.suspension.stiffness, ax.suspension.damping);
+                // a solid axle's wheels are numbered left (even), right (odd)
+                let (spring, damper, solid) = match &ax.solid_axle {
+                    None => (rate_k, rate_c, None),
+                    Some(sa) => {
+                        let (ks, kx) = SolidAxleSpec::coefficients(sa.spring_track, ax.track);
+                        let (cs, cx) = SolidAxleSpec::coefficients(sa.damper_track, ax.track);
+                        let coupling = SolidCoupling {
+                            partner: w ^ 1,
+                            spring_cross: rate_k * kx,
+                            damper_cross: rate_c * cx,
+                        };
+                        (rate_k * ks, rate_c * cs, Some(coupling))
+                    }
+                };
                 wheels.push(WheelModel {
                     attach,
                     y: side * 0.5 * ax.track,
@@ -163,8 +190,8 @@ impl Model {
                     half_width: 0.5 * ax.wheel.width,
                     rim_depth: ax.wheel.radius - ax.wheel.rim_radius,
                     unsprung_mass: mu,
-                    spring: ax.suspension.stiffness,
-                    damper: ax.suspension.damping,
+                    spring,
+                    damper,
                     bump: ax.suspension.bump_travel,
                     rebound: ax.suspension.rebound_travel,
                     stop: ax.suspension.stop_stiffness,
@@ -175,6 +202,7 @@ impl Model {
                     slip_damping_lat: 0.6 * (k_lat * lat_mass).sqrt(),
                     nominal_load: per_wheel_load,
                     static_compression: comp[k],
+                    solid,
                 });
             }
         }

@@ -151,6 +151,10 @@ impl Sim {
             let hub = state.position + r;
             e += 0.5 * m.unsprung_mass * v.norm_sq() + m.unsprung_mass * GRAVITY * hub.z;
             e += 0.5 * m.spring * w.compression * w.compression;
+            if let Some(sc) = &m.solid {
+                // half of the beam's cross term k_x·s_l·s_r; the partner adds the other half
+                e += 0.5 * sc.spring_cross * w.compression * state.wheels[sc.partner].compression;
+            }
             if w.compression > m.bump {
                 e += 0.5 * m.stop * (w.compression - m.bump).powi(2);
             }

@@ -75,6 +75,37 @@ pub struct AxleSpec {
     pub brake_torque: f64,
     pub suspension: SuspensionSpec,
     pub wheel: WheelSpec,
+    /// Present when the two wheels are the ends of one rigid beam axle (leaf-spring or
+    /// link-located solid axles) instead of sprung independently.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solid_axle: Option<SolidAxleSpec>,
+}
+
+/// A solid (beam) axle: the left and right wheels are the ends of one rigid beam, and the
+/// springs and dampers sit on the beam inboard of the wheels. `suspension.stiffness` and
+/// `suspension.damping` are then the rates of each spring and damper (vertical), at these
+/// lateral spacings. With wheel compressions s_l, s_r and track t, a spring at ±d/2 compresses
+/// by (s_l + s_r)/2 ± (d/t)(s_l − s_r)/2: the axle is as stiff as independent wheels of rate k
+/// in heave and (d/t)² times as stiff in roll (cross-axle articulation), the defining property
+/// of a beam axle. The beam's mass stays split between its ends (`wheel.unsprung_mass`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolidAxleSpec {
+    /// Lateral distance between the two springs \[m\] (0 < d ≤ track).
+    pub spring_track: f64,
+    /// Lateral distance between the two dampers \[m\] (0 < d ≤ track).
+    pub damper_track: f64,
+}
+
+impl SolidAxleSpec {
+    /// (self, cross) coefficients of a spring or damper at lateral spacing `d` on an axle of
+    /// track `t`: the force on a wheel is rate·(self·s_own + cross·s_other), with
+    /// self = (1 + r²)/2 and cross = (1 − r²)/2, r = d/t (the gradient of the two springs'
+    /// energy ½k·Σ((s_l + s_r)/2 ± r(s_l − s_r)/2)² with respect to each wheel's travel).
+    pub fn coefficients(d: f64, t: f64) -> (f64, f64) {
+        let r2 = (d / t).powi(2);
+        (0.5 * (1.0 + r2), 0.5 * (1.0 - r2))
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -448,6 +479,20 @@ impl VehicleSpec {
             }
             pos(&f("wheel.unsprung_mass"), w.unsprung_mass)?;
             pos(&f("wheel.spin_inertia"), w.spin_inertia)?;
+            if let Some(sa) = &ax.solid_axle {
+                for (name, d) in [
+                    ("spring_track", sa.spring_track),
+                    ("damper_track", sa.damper_track),
+                ] {
+                    pos(&f(&format!("solid_axle.{name}")), d)?;
+                    if d > ax.track {
+                        return Err(bad(
+                            f(&format!("solid_axle.{name}")),
+                            format!("{d} must not exceed the track {}", ax.track),
+                        ));
+                    }
+                }
+            }
             if i > 0 && ax.x >= self.axles[i - 1].x {
                 return Err(bad(
                     f("x"),
@@ -627,6 +672,15 @@ impl VehicleSpec {
                 if a.steered { ", steered" } else { "" },
                 if a.driven { ", driven" } else { "" }
             );
+            if let Some(sa) = &a.solid_axle {
+                let _ = writeln!(
+                    s,
+                    "          solid axle: springs {:.3} m apart, dampers {:.3} m apart (roll rate {:.0} % of heave)",
+                    sa.spring_track,
+                    sa.damper_track,
+                    100.0 * (sa.spring_track / a.track).powi(2)
+                );
+            }
         }
         match self.steering.kind {
             SteeringKind::Ackermann => {
@@ -679,6 +733,16 @@ impl VehicleSpec {
             self.tyre.rolling_resistance
         );
         let _ = write!(s, "  internal step    {} ms", self.internal_step * 1e3);
+        // a built-in (unchanged): what it stands for and where its numbers come from
+        if let Some(m) = crate::vehicles::mechanisms(&self.name)
+            && crate::vehicles::builtin(&self.name).is_ok_and(|b| b == *self)
+        {
+            let _ = write!(
+                s,
+                "\n  chassis          {}\n  suspension       {}\n  steering         {}\n  sources          {}; `verti vehicle show {} --yaml` cites each number",
+                m.chassis, m.suspension, m.steering, m.source, self.name
+            );
+        }
         s
     }
 }

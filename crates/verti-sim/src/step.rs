@@ -104,7 +104,7 @@ impl Sim {
                 let soil_b = ws.soil_patch_b;
                 let contact =
                     wheel_contact(terrain, &mut st.soil, &spec.tyre, m, soil_b, &kin, near);
-                let spring = spring_force(m, &ws);
+                let spring = spring_force(m, &ws, &st.wheels);
                 let tyre = friction::tyre_forces(&spec.tyre, spec.scale, m, &ws, &contact, &kin, h);
 
                 // the spin gets rolling resistance and the soil pressure moment about the axle,

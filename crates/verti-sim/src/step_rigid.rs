@@ -59,7 +59,7 @@ impl Sim {
             let near = stage.near;
             let (contact, rigid) =
                 rigid_wheel_contact(terrain, &mut st.soil, &spec.tyre, m, soil_b, &kin, near);
-            let spring = spring_force(m, &ws);
+            let spring = spring_force(m, &ws, &st.wheels);
             // Coulomb friction where the rigid contact carries the load, the soil's shear
             // where the soil does (and nothing in the air)
             // the spin gets rolling resistance and the soil pressure moment about the axle

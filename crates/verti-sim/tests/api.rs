@@ -19,7 +19,9 @@ fn builtin_vehicles_load_and_unknown_names_list_the_known_ones() {
             "verti4",
             "truck6",
             "truck8",
-            "m113"
+            "m113",
+            "uaz",
+            "gator"
         ]
     );
     for name in &names {
