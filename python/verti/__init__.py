@@ -29,13 +29,13 @@ from ._verti import (
     __version__,
     evaluate,
     load_worlds,
-    replay,
     systems,
     vehicles,
 )
 from .results import flatten_result, results_table, to_dataframe
 from .envs import NavigateEnv, NavigateVectorEnv, register_envs
 from . import data
+from .replay import replay
 
 register_envs()
 

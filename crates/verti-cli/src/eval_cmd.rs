@@ -359,7 +359,8 @@ pub struct ReplayArgs {
     #[arg(long)]
     out: PathBuf,
     /// A 3-D recording instead: one self-contained HTML page (WebGL, no server) with the
-    /// terrain, obstacles, vehicle body and wheels, path, trail and time series.
+    /// terrain, obstacles, vehicle body and wheels, path, trail and time series; or, with a
+    /// .json --out, the recording itself (for `python -m verti.rerun`, Rerun's .rrd).
     #[arg(long = "3d")]
     three_d: bool,
     /// Pixels per heightfield cell.
@@ -374,39 +375,47 @@ pub fn replay(a: ReplayArgs) -> CmdResult {
     let by_name = |name: &str| load_vehicle(name).map_err(|e| e.to_string());
     let mut setup = verti_bench::replay::prepare(&a.result, a.task, &registry, &by_name)?;
     let (world, vehicle, pair) = (setup.world.clone(), setup.vehicle.clone(), setup.pair);
-    let html = a.out.extension().and_then(|e| e.to_str()) == Some("html");
-    if !a.three_d && html {
+    let ext = a.out.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let three_d_file = ext == "html" || ext == "json";
+    if !a.three_d && three_d_file {
         return Err(format!(
-            "--out {}: an HTML page is a 3-D replay: pass --3d (or name the picture .png)",
+            "--out {}: an .{ext} output is a 3-D replay: pass --3d (or name the picture .png)",
             a.out.display()
         )
         .into());
     }
     if a.three_d {
-        if !html {
+        if !three_d_file {
             return Err(format!(
-                "--out {}: a 3-D replay is an HTML page; name it .html",
+                "--out {}: a 3-D replay is an HTML page (.html) or its recording (.json)",
                 a.out.display()
             )
             .into());
         }
-        verti_core::output::check_output_file(&a.out, &["html"])
-            .map_err(|problem| format!("{}: {problem}", a.out.display()))?;
         let (recording, replayed) =
             verti_view::record_trial(&world, &vehicle, pair, setup.system.as_mut(), &setup.cfg);
         if let Some(w) = setup.mismatch(&replayed) {
             eprintln!("warning: {w}");
         }
-        verti_view::write_html(&recording, &a.out)
-            .map_err(|e| format!("{}: {e}", a.out.display()))?;
+        let written = if ext == "json" {
+            verti_view::write_json(&recording, &a.out)
+        } else {
+            verti_view::write_html(&recording, &a.out)
+        };
+        written.map_err(|e| format!("{}: {e}", a.out.display()))?;
         println!(
-            "task {} ({} pair {pair}): {} after {:.1} s; {} frames in {} (open it in a browser)",
+            "task {} ({} pair {pair}): {} after {:.1} s; {} frames in {}{}",
             a.task,
             world.meta.name,
             replayed.outcome.name(),
             replayed.time,
             recording.frames.len(),
-            a.out.display()
+            a.out.display(),
+            if ext == "json" {
+                " (a Rerun recording: python -m verti.rerun FILE.json FILE.rrd)"
+            } else {
+                " (open it in a browser)"
+            }
         );
         return Ok(());
     }

@@ -2,6 +2,7 @@
 
 mod compare_cmd;
 mod data_cmd;
+mod drive_cmd;
 mod eval_cmd;
 mod kino_cmd;
 mod learn_cmd;
@@ -50,6 +51,9 @@ enum Command {
     Systems(SystemsCommand),
     /// Evaluate a mobility system on a world set (parallel, resumable).
     Eval(eval_cmd::EvalArgs),
+    /// Drive a task yourself in real time, watching it live in the browser (or watch a
+    /// system drive); recorded as a demonstration dataset.
+    Drive(drive_cmd::DriveArgs),
     /// Join the run directories of a sharded evaluation (`verti eval --shard i/N`) into one.
     Merge(merge_cmd::MergeArgs),
     /// Draw one evaluated trial's trajectory over its world.
@@ -102,6 +106,7 @@ fn main() -> ExitCode {
         Command::Sim(cmd) => vehicle_cmd::run_sim(cmd),
         Command::Systems(SystemsCommand::List) => eval_cmd::systems_list(),
         Command::Eval(a) => eval_cmd::eval(a),
+        Command::Drive(a) => drive_cmd::drive(a),
         Command::Merge(a) => merge_cmd::merge(a),
         Command::Replay(a) => eval_cmd::replay(a),
         Command::Report(a) => eval_cmd::report(a),

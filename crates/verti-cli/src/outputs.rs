@@ -13,10 +13,11 @@ pub fn png_file(text: &str) -> Result<PathBuf, String> {
     Ok(path)
 }
 
-/// A replay's output: a `.png` picture or a `.html` 3-D page, in an existing directory.
+/// A replay's output: a `.png` picture, or with `--3d` an `.html` page or the `.json` recording,
+/// in an existing directory.
 pub fn replay_file(text: &str) -> Result<PathBuf, String> {
     let path = PathBuf::from(text);
-    check_output_file(&path, &["png", "html"])?;
+    check_output_file(&path, &["png", "html", "json"])?;
     Ok(path)
 }
 

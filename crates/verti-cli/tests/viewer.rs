@@ -135,3 +135,81 @@ fn the_3d_page_draws_in_a_headless_browser() {
     assert!(speed_pixels > 50, "{speed_pixels} speed-curve pixels");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_live_view_shows_a_system_driving_and_the_session_is_saved() {
+    use std::io::{BufRead, BufReader, Read, Write};
+    let Some(browser) = chromium() else {
+        eprintln!("skipped: no Chromium (install Debian's chromium, or set VERTI_CHROMIUM)");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("verti-live-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("demo");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_verti"))
+        .args([
+            "drive", "--system", "pid", "--worlds", "verti-4", "--task", "1", "--port", "0",
+            "--speed", "4", "--out",
+        ])
+        .arg(&out)
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    let first = lines.next().unwrap().unwrap();
+    let url = first
+        .split_whitespace()
+        .find(|w| w.starts_with("http://"))
+        .unwrap()
+        .to_string();
+    let png = dir.join("live.png");
+    let shot = Command::new(&browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--use-angle=swiftshader",
+            "--enable-unsafe-swiftshader",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--no-first-run",
+            "--window-size=1000,700",
+            "--virtual-time-budget=4000",
+        ])
+        .arg(format!("--user-data-dir={}", dir.join("profile").display()))
+        .arg(format!("--screenshot={}", png.display()))
+        .arg(&url)
+        .output()
+        .unwrap();
+    assert!(png.exists(), "{}", String::from_utf8_lossy(&shot.stderr));
+    // stop the session the way the page's button does
+    let addr = url.trim_start_matches("http://").trim_end_matches('/');
+    let mut s = std::net::TcpStream::connect(addr).unwrap();
+    write!(s, "GET /quit HTTP/1.1\r\nHost: x\r\n\r\n").unwrap();
+    let mut reply = String::new();
+    s.read_to_string(&mut reply).unwrap();
+    assert!(child.wait().unwrap().success());
+    let rest: Vec<String> = lines.map_while(Result::ok).collect();
+    assert!(
+        rest.iter().any(|l| l.contains("demonstration in")),
+        "{rest:?}"
+    );
+    let img = image::open(&png).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (1000, 700));
+    // the dataset, the result and the replay page are there
+    for f in [
+        "manifest.yaml",
+        "result.json",
+        "replay.html",
+        "steps-00000.parquet",
+    ] {
+        assert!(out.join(f).exists(), "{f}");
+    }
+    let result: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("result.json")).unwrap()).unwrap();
+    assert_eq!(result["system"], "pid");
+    assert!(result["path_length"].as_f64().unwrap() > 1.0, "{result}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

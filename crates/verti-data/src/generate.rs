@@ -455,8 +455,9 @@ fn drive(
     }
 }
 
-/// The row of `trial`'s current state with `action` as the command.
-fn row(trial: &Trial, action: Action) -> Row {
+/// The row of `trial`'s current state with `action` as the command (every kind of data,
+/// human demonstrations included, is recorded through this one function).
+pub fn row(trial: &Trial, action: Action) -> Row {
     let features: [f64; FEATURES] = trial.features().extract(&Feature::ALL);
     let (steering, speed) = match action {
         Action::HighLevel { speed, steering } => (steering, speed),

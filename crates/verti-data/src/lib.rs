@@ -33,7 +33,7 @@ pub use manifest::{DataOutcome, Kind, Manifest};
 pub use profile::Profile;
 pub use reader::{Dataset, TrialView};
 pub use sampler::{Batch, WindowSampler};
-pub use store::{WriteInfo, write_dataset};
+pub use store::{WriteInfo, write_dataset, write_trials};
 
 /// Everything that can go wrong with a dataset, each naming the file or flag at fault.
 #[derive(Debug, thiserror::Error)]

@@ -58,6 +58,47 @@ fn prepare_dir(dir: &Path, force: bool) -> Result<()> {
     Ok(())
 }
 
+/// Writes trials recorded elsewhere (human demonstrations from `verti drive`) as a dataset in
+/// `dir`: the same Parquet tables and manifest as generated data, so both load and mix alike.
+/// `manifest` gives the identity fields; files, checksums, counts and hours are filled here.
+pub fn write_trials(
+    dir: &Path,
+    trials: &[TrialRecord],
+    mut manifest: Manifest,
+    force: bool,
+) -> Result<Manifest> {
+    prepare_dir(dir, force)?;
+    let mut files = Vec::new();
+    for (n, chunk) in trials.chunks(FILE_TRIALS).enumerate() {
+        let name = file_name(n);
+        let path = dir.join(&name);
+        write_table(&path, &Table::from_trials(chunk, manifest.wheels))?;
+        let bytes = std::fs::read(&path).map_err(|e| DataError::file(&path, e))?;
+        files.push((name, checksum(&bytes)));
+    }
+    let seconds: f64 = trials.iter().map(TrialRecord::duration).sum();
+    manifest.format = FORMAT.to_string();
+    manifest.trials = trials.len();
+    manifest.rows = trials.iter().map(|t| t.rows.len()).sum();
+    manifest.hours = seconds / 3600.0;
+    manifest.hours_simulated = seconds / 3600.0;
+    manifest.outcomes.clear();
+    for t in trials {
+        *manifest
+            .outcomes
+            .entry(t.outcome.name().to_string())
+            .or_insert(0) += 1;
+    }
+    let mut indices: Vec<u32> = trials.iter().map(|t| t.world).collect();
+    indices.sort_unstable();
+    indices.dedup();
+    manifest.worlds.indices = indices;
+    manifest.checksums = files.iter().cloned().collect();
+    manifest.files = files.into_iter().map(|f| f.0).collect();
+    manifest.write(dir)?;
+    Ok(manifest)
+}
+
 /// Generates the dataset `cfg` describes into `dir` and writes its manifest (last, so a
 /// directory without one is an unfinished run). `progress` gets budget seconds as they pass.
 pub fn write_dataset(

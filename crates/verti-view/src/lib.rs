@@ -10,7 +10,7 @@
 
 mod record;
 
-pub use record::{Frame, Recording, record_trial};
+pub use record::{Frame, Recording, frame, record_trial};
 
 /// The viewer page; `/*VERTI_DATA*/` is replaced by the recording as JSON.
 const VIEWER: &str = include_str!("viewer.html");
@@ -21,6 +21,15 @@ pub fn html(recording: &Recording) -> String {
     // inside <script type="application/json">, only "</" could end the element early
     let json = json.replace("</", "<\\/");
     VIEWER.replacen("/*VERTI_DATA*/", &json, 1)
+}
+
+/// Writes the recording as JSON (for other viewers: `python -m verti.rerun` turns it into a
+/// Rerun `.rrd`).
+pub fn write_json(recording: &Recording, path: &std::path::Path) -> std::io::Result<()> {
+    std::fs::write(
+        path,
+        serde_json::to_string(recording).expect("a recording serialises"),
+    )
 }
 
 /// Writes [`html`] to `path`.

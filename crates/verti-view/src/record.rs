@@ -66,10 +66,15 @@ pub struct Recording {
     /// The trial's outcome and result line.
     pub outcome: String,
     pub result: serde_json::Value,
+    /// Set on a live page: it asks its server for new frames and sends the keys held.
+    #[serde(default)]
+    pub live: bool,
 }
 
-fn frame(trial: &Trial, spec: &VehicleSpec) -> Frame {
+/// The scene now: body, wheels and commands of `trial`.
+pub fn frame(trial: &Trial) -> Frame {
     let (sim, state) = (trial.sim(), trial.state());
+    let spec = sim.spec();
     let [bx, by, bz] = spec.chassis.collision_box.center;
     let box_centre = sim.point_world(state, Vec3::new(bx, by, bz));
     let q = state.orientation();
@@ -177,6 +182,42 @@ fn scene(world: &World, pair: u32, cfg: &EpisodeConfig) -> Recording {
         frames: Vec::new(),
         outcome: String::new(),
         result: serde_json::Value::Null,
+        live: false,
+    }
+}
+
+impl Recording {
+    /// The still scene of task `pair` of `world` driven by `spec`, with no frames yet.
+    pub fn start(world: &World, spec: &VehicleSpec, pair: u32, cfg: &EpisodeConfig) -> Recording {
+        let mut rec = scene(world, pair, cfg);
+        let b = spec.chassis.collision_box.size;
+        rec.body_size = [r4(b[0]), r4(b[1]), r4(b[2])];
+        rec.wheel_size = spec
+            .axles
+            .iter()
+            .flat_map(|a| {
+                let w = [r4(a.wheel.radius), r4(a.wheel.width)];
+                [w, w]
+            })
+            .collect();
+        rec.title = format!("{} on {} pair {pair}", spec.name, world.meta.name);
+        rec
+    }
+
+    /// Records how the trial ended.
+    pub fn finish(&mut self, result: &TrialResult) {
+        self.outcome = result.outcome.name().to_string();
+        self.title = format!(
+            "{} on task {} ({}, {} elevation, {}, {} obstacles): {}",
+            result.system,
+            result.task,
+            result.world_name,
+            format!("{:?}", result.level).to_lowercase(),
+            format!("{:?}", result.terrain_type).to_lowercase(),
+            format!("{:?}", result.density).to_lowercase(),
+            self.outcome
+        );
+        self.result = serde_json::to_value(result).unwrap_or_default();
     }
 }
 
@@ -190,33 +231,12 @@ pub fn record_trial(
     system: &mut dyn MobilitySystem,
     cfg: &EpisodeConfig,
 ) -> (Recording, TrialResult) {
-    let mut rec = scene(world, pair, cfg);
+    let mut rec = Recording::start(world, spec, pair, cfg);
     let mut frames = Vec::new();
     let result = run_episode_watched(world, spec, pair, system, cfg, None, &mut |trial| {
-        frames.push(frame(trial, spec));
+        frames.push(frame(trial));
     });
-    let b = spec.chassis.collision_box.size;
-    rec.body_size = [r4(b[0]), r4(b[1]), r4(b[2])];
-    rec.wheel_size = spec
-        .axles
-        .iter()
-        .flat_map(|a| {
-            let w = [r4(a.wheel.radius), r4(a.wheel.width)];
-            [w, w]
-        })
-        .collect();
     rec.frames = frames;
-    rec.outcome = format!("{:?}", result.outcome).to_lowercase();
-    rec.title = format!(
-        "{} on task {} ({}, {} elevation, {}, {} obstacles): {}",
-        result.system,
-        result.task,
-        result.world_name,
-        format!("{:?}", result.level).to_lowercase(),
-        format!("{:?}", result.terrain_type).to_lowercase(),
-        format!("{:?}", result.density).to_lowercase(),
-        rec.outcome
-    );
-    rec.result = serde_json::to_value(&result).unwrap_or_default();
+    rec.finish(&result);
     (rec, result)
 }

@@ -205,7 +205,7 @@ fn verti_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(vehicles, m)?)?;
     m.add_function(wrap_pyfunction!(systems, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate, m)?)?;
-    m.add_function(wrap_pyfunction!(replay::replay, m)?)?;
+    m.add_function(wrap_pyfunction!(replay::_replay, m)?)?;
     m.add_function(wrap_pyfunction!(data::_load_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(data::_generate_dataset, m)?)?;
     m.add("SimulationError", py.get_type::<SimulationError>())?;

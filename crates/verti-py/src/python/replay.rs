@@ -6,17 +6,18 @@ use super::*;
 /// `verti.evaluate(..., out=...)`) and writes its 3-D recording to `out`, a self-contained
 /// HTML page (terrain, obstacles, vehicle body and wheels, path, trail, time series). Returns
 /// the replayed trial's result dict; warns if it ended otherwise than the recorded one.
+/// A `.json` output gets the recording itself (what `verti.rerun` converts to Rerun's format).
 #[pyfunction]
 #[pyo3(signature = (run, task, out))]
-pub(super) fn replay(py: Python<'_>, run: PathBuf, task: u32, out: PathBuf) -> PyResult<Py<PyAny>> {
-    if out.extension().and_then(|e| e.to_str()) != Some("html") {
-        return Err(value_err(format!(
-            "out {}: a 3-D replay is an HTML page; name it .html",
-            out.display()
-        )));
-    }
-    verti_core::output::check_output_file(&out, &["html"])
+pub(super) fn _replay(
+    py: Python<'_>,
+    run: PathBuf,
+    task: u32,
+    out: PathBuf,
+) -> PyResult<Py<PyAny>> {
+    verti_core::output::check_output_file(&out, &["html", "json"])
         .map_err(|p| value_err(format!("{}: {p}", out.display())))?;
+    let as_json = out.extension().and_then(|e| e.to_str()) == Some("json");
     let registry = system_registry();
     let by_name = |name: &str| vehicle_spec(name).map_err(|e| e.to_string());
     let mut setup =
@@ -36,8 +37,12 @@ pub(super) fn replay(py: Python<'_>, run: PathBuf, task: u32, out: PathBuf) -> P
         let text = std::ffi::CString::new(w.replace('\0', " ")).expect("no NUL left");
         PyErr::warn(py, &category, &text, 1)?;
     }
-    verti_view::write_html(&recording, &out)
-        .map_err(|e| PyOSError::new_err(format!("{}: {e}", out.display())))?;
+    let written = if as_json {
+        verti_view::write_json(&recording, &out)
+    } else {
+        verti_view::write_html(&recording, &out)
+    };
+    written.map_err(|e| PyOSError::new_err(format!("{}: {e}", out.display())))?;
     results_to_py(py, &[replayed])?
         .pop()
         .ok_or_else(|| PyRuntimeError::new_err("no result"))
