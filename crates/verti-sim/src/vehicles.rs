@@ -22,6 +22,8 @@ const BUILTINS: &[(&str, &str)] = &[
     // wishbone and rack-and-pinion steering
     ("uaz", include_str!("../vehicles/uaz.yaml")),
     ("gator", include_str!("../vehicles/gator.yaml")),
+    // a road car: double wishbone in front, multilink rear, rack-and-pinion steering
+    ("sedan", include_str!("../vehicles/sedan.yaml")),
 ];
 
 /// Names of the built-in vehicles.
@@ -150,6 +152,16 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
                          rigid rear axle (a spring as stiff as the step allows)",
             steering: "rack and pinion, modelled as Ackermann geometry up to the 25° road-wheel angle",
             source: "Chrono Gator (src/chrono_models/vehicle/gator, data/vehicle/gator/json)",
+        },
+        "sedan" => Mechanisms {
+            chassis: "4-wheeled",
+            suspension_families: &["double wishbone", "multilink"],
+            steering_families: &["rack-and-pinion"],
+            suspension: "double wishbone in front, multilink rear (upper A-arm, lateral, trailing \
+                         and toe links), modelled as independent wheels at their wheel rates (coil \
+                         motion ratios 0.519 front, 0.612 rear, by virtual work)",
+            steering: "rack and pinion, modelled as Ackermann geometry up to the 25° road-wheel angle",
+            source: "Chrono Sedan, C++ model (src/chrono_models/vehicle/sedan)",
         },
         _ => return None,
     })

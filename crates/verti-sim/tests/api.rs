@@ -21,7 +21,8 @@ fn builtin_vehicles_load_and_unknown_names_list_the_known_ones() {
             "truck8",
             "m113",
             "uaz",
-            "gator"
+            "gator",
+            "sedan"
         ]
     );
     for name in &names {

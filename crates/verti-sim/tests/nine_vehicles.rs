@@ -1,6 +1,6 @@
 //! The paper's nine vehicle types (Verti-Bench §III-E): every scale, chassis, suspension family
-//! and steering family of its list is shipped, and the vehicles added for them (`uaz`, `gator`)
-//! pass the validation tests that apply to them. Every expected number is derived on paper from
+//! and steering family of its list is shipped, and the vehicles added for them (`uaz`, `gator`,
+//! `sedan`) pass the validation tests that apply to them. Every expected number is derived on paper from
 //! the vehicle file; the tolerance is stated in the test.
 
 use std::sync::Arc;
@@ -86,15 +86,19 @@ fn every_scale_chassis_suspension_and_steering_family_is_shipped() {
     let mut edited = uaz.clone();
     edited.chassis.mass += 1.0;
     assert!(!edited.summary().contains("sources"));
+    let sedan = vehicles::builtin("sedan").unwrap();
+    assert!(sedan.summary().contains("multilink"), "{}", sedan.summary());
 }
 
 // Static sag per corner = m·g/k within 2 % (lever-rule sprung corner load over the spring
 // rate). On the UAZ's solid axles both wheels rise together at rest, so each spring carries its
 // corner exactly as an independent wheel would (heave rate = k). The Gator's front rate is its
-// strut through the 0.6215 motion ratio; its rear is the stiff "rigid axle" spring.
+// strut through the 0.6215 motion ratio; its rear is the stiff "rigid axle" spring. The Sedan's
+// rates are its coils through the motion ratios 0.5194 (double wishbone) and 0.6120 (multilink):
+// a soft front (187 mm of sag, which Chrono's coil holds in its preload) and a stiffer rear.
 #[test]
 fn static_sag_of_the_new_vehicles() {
-    for name in ["uaz", "gator"] {
+    for name in ["uaz", "gator", "sedan"] {
         let spec = vehicles::builtin(name).unwrap();
         let (sim, mut st) = sim_at(testing::flat_world(1.0, 0.8), &spec);
         run(&sim, &mut st, Controls::new(0.0, 1.0, 0.0), 3.0);
@@ -212,11 +216,12 @@ fn total_com(spec: &VehicleSpec) -> (f64, f64) {
 }
 
 /// Largest |roll| over 4 s parked (full brakes) across a side slope of `deg`, left uphill,
-/// ground friction 2 and tyres as grippy, so the vehicle tips before it slides.
-fn max_roll_parked_across(spec: &VehicleSpec, deg: f64) -> f64 {
+/// ground friction `mu` (> tan of the slope) and tyres as grippy, so the vehicle tips before it
+/// slides.
+fn max_roll_parked_across(spec: &VehicleSpec, deg: f64, mu: f64) -> f64 {
     let mut spec = spec.clone();
-    spec.tyre.friction = 2.0;
-    let (sim, mut st) = sim_at(testing::plane_world(1.0, 0.0, deg.to_radians(), 2.0), &spec);
+    spec.tyre.friction = mu;
+    let (sim, mut st) = sim_at(testing::plane_world(1.0, 0.0, deg.to_radians(), mu), &spec);
     let mut worst: f64 = 0.0;
     for _ in 0..400 {
         sim.step(&mut st, Controls::new(0.0, 1.0, 0.0), 0.01)
@@ -236,17 +241,28 @@ fn max_roll_parked_across(spec: &VehicleSpec, deg: f64) -> f64 {
 // 0.95·φ it stays upright (it may lean up to 10° beyond the slope on springs and tyres); at
 // 1.05·φ it rolls over. The UAZ's beam axles are soft in roll (the springs 1.03 m apart on a
 // 1.465 m track: 49 % of the heave rate), so it leans a few degrees more than a rigid body and
-// may tip a little early, as a leaf-sprung 4x4 does: it is tested at 0.90·φ and 1.05·φ.
+// may tip a little early, as a leaf-sprung 4x4 does: it is tested at 0.90·φ and 1.05·φ. The
+// Sedan is low and wide (φ ≈ 62.3°; tan 1.05·φ > 2, so it is parked on friction 3) but soft in
+// roll with no anti-roll bar: the stiff rear takes the roll moment until its uphill wheel lifts
+// (≈ 50°), then the body rolls on the soft front coils alone. When the front uphill wheel
+// unloads, the downhill one carries m·g·cos θ / 2 (≈ 4.0 kN at 57°): 0.204 m of compression on
+// the 19.8 kN/m wheel rate, a lean of 0.204 / 1.596 m = 7.3° beyond the slope, so it tips near
+// φ − 7° (measured: upright at 56°, leaning 5.1°; over at 57°), as a car on a tilt table whose
+// roll is not in the rigid-body φ. Tested upright at 0.88·φ (54.9°) and over at 1.05·φ.
 #[test]
 fn tilt_table_of_the_new_vehicles() {
-    for (name, below_factor) in [("uaz", 0.90), ("gator", 0.95)] {
+    for (name, below_factor, mu) in [
+        ("uaz", 0.90, 2.0),
+        ("gator", 0.95, 2.0),
+        ("sedan", 0.88, 3.0),
+    ] {
         let spec = vehicles::builtin(name).unwrap();
         let (behind, h) = total_com(&spec);
         let f = behind / (spec.axles[0].x - spec.axles[1].x);
         let y = 0.5 * ((1.0 - f) * spec.axles[0].track + f * spec.axles[1].track);
         let phi = (y / h).atan().to_degrees();
-        let below = max_roll_parked_across(&spec, below_factor * phi).to_degrees();
-        let above = max_roll_parked_across(&spec, 1.05 * phi).to_degrees();
+        let below = max_roll_parked_across(&spec, below_factor * phi, mu).to_degrees();
+        let above = max_roll_parked_across(&spec, 1.05 * phi, mu).to_degrees();
         println!(
             "{name}: φ {phi:.2}° (h {h:.3} m, y {y:.3} m); max roll at {below_factor}φ {below:.1}°, at 1.05φ {above:.1}°"
         );
@@ -282,7 +298,8 @@ fn stopping_distance(spec: &VehicleSpec, mu: f64, v0: f64) -> f64 {
 // Gator: brakes on the rear wheels only (1600 N·m each ≫ μ·N·R ≈ 0.5 kN·m), so they lock
 // while the front wheels roll free; with the rear axle load N_r = m(g·a − d·h)/L under
 // deceleration d (a the COM's distance behind the front axle), d = μ·g·a / (L + μ·h) ≈ 2.0
-// m/s², about 24.7 m. Within 10 %.
+// m/s², about 24.7 m. Sedan: 2000 N·m on every wheel ≫ μ·m·g·R / 4 ≈ 0.5 kN·m, so all four
+// lock (the front pair through the locked differential too) and it slides: 12.74 m. Within 10 %.
 #[test]
 fn braking_distance_of_the_new_vehicles() {
     let (mu, v0) = (0.4, 10.0);
@@ -300,15 +317,21 @@ fn braking_distance_of_the_new_vehicles() {
     let d = stopping_distance(&gator, mu, v0);
     println!("gator: stopped in {d:.2} m vs rear-locked {expected:.2} m (d {decel:.3} m/s²)");
     assert!((d - expected).abs() < 0.1 * expected);
+
+    let sedan = vehicles::builtin("sedan").unwrap();
+    let d = stopping_distance(&sedan, mu, v0);
+    let expected = v0 * v0 / (2.0 * mu * G);
+    println!("sedan: stopped in {d:.2} m vs v²/2μg {expected:.2} m");
+    assert!((d - expected).abs() < 0.1 * expected);
 }
 
 // Steady low-speed cornering follows Ackermann geometry: at half lock, δ = max/2, the rear
 // axle's centre circles at R = L / tan δ (UAZ: L 2.38 m, δ 13.5°, R 9.9 m; Gator: L 1.94 m,
-// δ 12.5°, R 8.75 m), within 5 %. Speed ≈ 1.5 m/s by throttle alone; open differentials, as a
+// δ 12.5°, R 8.75 m; Sedan: L 2.776 m, δ 12.5°, R 12.52 m), within 5 %. Speed ≈ 1.5 m/s by throttle alone; open differentials, as a
 // locked axle scrubs (a powertrain effect, not steering geometry).
 #[test]
 fn low_speed_cornering_of_the_new_vehicles() {
-    for name in ["uaz", "gator"] {
+    for name in ["uaz", "gator", "sedan"] {
         let mut spec = vehicles::builtin(name).unwrap();
         spec.powertrain.axle_differential = Differential::Open;
         spec.powertrain.central_differential = Differential::Open;
