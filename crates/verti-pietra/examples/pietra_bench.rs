@@ -33,6 +33,7 @@ fn main() {
         prior: PriorConfig::default(),
         bins: param_bins(),
         alpha: 0.5,
+        surface: None,
     };
     for (name, source) in [
         ("model", Source::Model(&model)),

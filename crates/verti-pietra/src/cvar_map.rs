@@ -83,6 +83,22 @@ pub struct MapSpec {
     pub bins: [Bins; PARAMS],
     /// Risk tolerance α ∈ (0, 1] (1: the mean).
     pub alpha: f64,
+    /// The world's terrain classes, for the semantics-aware prior (beyond the paper, which
+    /// maps dirt only): each wheel's slope limit scales with its ground's friction
+    /// ([`crate::prior::slope_limit`]). None: dirt everywhere, the paper's prior.
+    pub surface: Option<std::sync::Arc<verti_world::PatchGrid>>,
+}
+
+impl MapSpec {
+    /// Ground friction under (x, y): the class's (Coulomb μ of rigid ground, tan φ of soil),
+    /// or dirt's without semantics.
+    #[inline(always)]
+    pub fn friction_at(&self, x: f64, y: f64) -> f64 {
+        match &self.surface {
+            None => crate::prior::DIRT_FRICTION,
+            Some(p) => p.at(x, y).surface.effective_friction(),
+        }
+    }
 }
 
 /// The risk-aware traversability of a region.
@@ -106,7 +122,13 @@ pub fn footprint_cvar(
     yaw: f64,
     scratch: &mut (Vec<f32>, Option<crate::model::TravScratch>),
 ) -> ([f64; PARAMS], bool) {
-    let fp = footprint(terrain, &spec.layout, x, y, yaw);
+    let mut fp = footprint(terrain, &spec.layout, x, y, yaw);
+    if spec.surface.is_some() {
+        let (s, c) = yaw.sin_cos();
+        for (k, w) in spec.layout.wheels.iter().enumerate() {
+            fp.friction[k] = spec.friction_at(x + w[0] * c - w[1] * s, y + w[0] * s + w[1] * c);
+        }
+    }
     let physics = physics_prior(&fp, &spec.prior, &spec.bins);
     let (pmf, ood): ([Pmf; PARAMS], bool) = match source {
         Source::Physics => (physics, false),
@@ -268,6 +290,7 @@ mod tests {
             prior: PriorConfig::default(),
             bins: param_bins(),
             alpha,
+            surface: None,
         }
     }
 
@@ -361,6 +384,85 @@ mod tests {
                 };
                 assert_eq!(bits64(&fast_row.0), bits64(&slow_row.0));
             }
+        }
+    }
+
+    /// A grid of 16 x 16 patches whose classes cycle through all ten, each with its class's
+    /// physics.
+    fn all_classes(cell: f64) -> std::sync::Arc<verti_world::PatchGrid> {
+        use verti_world::{Patch, Surface, TerrainClass};
+        let patches = (0..256)
+            .map(|i| {
+                let class = TerrainClass::from_id(i % 10).unwrap();
+                let surface = match (class.friction_distribution(), class.soil()) {
+                    (Some((mu, _)), _) => Surface::Rigid {
+                        friction: mu,
+                        restitution: 0.0,
+                    },
+                    (None, Some(soil)) => Surface::Deformable { soil },
+                    (None, None) => unreachable!("every class is rigid or soil"),
+                };
+                Patch { class, surface }
+            })
+            .collect();
+        std::sync::Arc::new(verti_world::PatchGrid::new(patches, cell))
+    }
+
+    #[test]
+    fn semantics_follow_friction_and_the_fast_path_matches() {
+        // on a 15° ramp, grass everywhere leaves less traction uphill than dirt, concrete more
+        let n = 81;
+        let slope = 15f64.to_radians().tan();
+        let h: Vec<f64> = (0..n * n)
+            .map(|i| slope * ((i % n) as f64 - 40.0) * 0.5)
+            .collect();
+        let ramp = Heightfield::new(n, 0.5, h);
+        let uniform = |class: i64| {
+            use verti_world::{Patch, Surface, TerrainClass};
+            let class = TerrainClass::from_id(class).unwrap();
+            let friction = class.friction_distribution().unwrap().0;
+            let patch = Patch {
+                class,
+                surface: Surface::Rigid {
+                    friction,
+                    restitution: 0.0,
+                },
+            };
+            std::sync::Arc::new(verti_world::PatchGrid::new(vec![patch; 256], 0.5))
+        };
+        let region = Region::around(0.0, 0.0, 1.0, 5, 5);
+        let traction_up = |surface| {
+            let spec = MapSpec {
+                surface,
+                ..spec(0.5)
+            };
+            CvarMap::build(&ramp, &spec, Source::Physics, region)
+                .at(0.0, 0.0, 0.0)
+                .unwrap()[0]
+        };
+        let dirt = traction_up(None);
+        let (grass, concrete) = (traction_up(Some(uniform(3))), traction_up(Some(uniform(1))));
+        assert!(grass < dirt && dirt < concrete, "{grass} {dirt} {concrete}");
+        // dirt classes read as the paper's prior, bit for bit
+        assert_eq!(traction_up(Some(uniform(2))).to_bits(), dirt.to_bits());
+
+        // the batched path reads the classes as the one-footprint path does, bit for bit
+        let model = crate::shipped::pietra_v1().unwrap();
+        let world = &crate::maps::split_maps(crate::maps::Split::Test)[0];
+        let t = &world.terrain;
+        let sem = MapSpec {
+            surface: Some(all_classes(t.cell())),
+            ..spec(0.5)
+        };
+        let region = Region::around(0.0, 0.0, 0.5, 37, 4);
+        for source in [Source::Model(&model), Source::Physics] {
+            let fast = CvarMap::build(t, &sem, source, region);
+            let slow = CvarMap::build_reference(t, &sem, source, region);
+            let bits = |m: &CvarMap| m.values.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&fast), bits(&slow));
+            // and the classes changed the map
+            let plain = CvarMap::build(t, &spec(0.5), source, region);
+            assert_ne!(bits(&fast), bits(&plain));
         }
     }
 }

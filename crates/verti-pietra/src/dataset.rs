@@ -161,6 +161,7 @@ pub fn footprint(
         wheelbase: layout.wheelbase,
         vegetation: [0.0; 4],
         veg_fraction: 0.0,
+        friction: [crate::prior::DIRT_FRICTION; 4],
     }
 }
 

@@ -87,9 +87,13 @@ fn offset(x: f64, y: f64, p: &[f64; 4]) -> (f64, f64) {
 fn footprint(terrain: &Heightfield, spec: &MapSpec, h: &Heading, x: f64, y: f64) -> Footprint {
     let mut heights = [0.0; 4];
     let mut slopes = [0.0; 4];
+    let mut friction = [crate::prior::DIRT_FRICTION; 4];
     for (k, w) in h.wheel.iter().enumerate() {
         let (wx, wy) = offset(x, y, w);
         heights[k] = height_at(terrain, wx, wy);
+        if spec.surface.is_some() {
+            friction[k] = spec.friction_at(wx, wy);
+        }
         let (ax, ay) = offset(wx, wy, &h.ahead);
         let (bx, by) = offset(wx, wy, &h.behind);
         slopes[k] = ((height_at(terrain, ax, ay) - height_at(terrain, bx, by)) / SLOPE_BASE).atan();
@@ -101,6 +105,7 @@ fn footprint(terrain: &Heightfield, spec: &MapSpec, h: &Heading, x: f64, y: f64)
         wheelbase: spec.layout.wheelbase,
         vegetation: [0.0; 4],
         veg_fraction: 0.0,
+        friction,
     }
 }
 

@@ -38,6 +38,8 @@ pub struct CvarRollout {
     world_name: String,
     wheelbase: f64,
     max_steer: f64,
+    /// Read the world's terrain classes into the prior ([`MapSpec::surface`]).
+    semantics: bool,
 }
 
 /// Channels the rollout writes for the cost.
@@ -57,7 +59,15 @@ impl CvarRollout {
             world_name: String::new(),
             wheelbase: layout.wheelbase,
             max_steer: 0.5,
+            semantics: false,
         }
+    }
+
+    /// The semantics-aware variant: the prior's slope limits follow each wheel's ground
+    /// friction from the world's terrain classes (the paper's maps are dirt only).
+    pub fn with_semantics(mut self, on: bool) -> CvarRollout {
+        self.semantics = on;
+        self
     }
 
     /// The map of the current trial's world (after the first plan).
@@ -91,6 +101,7 @@ impl RolloutModel for CvarRollout {
                 prior,
                 bins,
                 alpha: self.alpha,
+                surface: self.semantics.then(|| Arc::new(world.patches.clone())),
             };
             let source = match &self.source {
                 TravSource::Physics => Source::Physics,
@@ -112,6 +123,9 @@ impl RolloutModel for CvarRollout {
                 },
                 alpha: self.alpha.to_bits(),
                 cell: region.cell.to_bits(),
+                // the classes matter only to the semantics-aware prior; perception noise can
+                // change them without the terrain, so they are keyed by content
+                semantics: self.semantics.then(|| patches_digest(&world.patches)),
                 wheels: self
                     .layout
                     .wheels
@@ -176,7 +190,22 @@ struct MapKey {
     model: String,
     alpha: u64,
     cell: u64,
+    semantics: Option<u64>,
     wheels: Vec<u64>,
+}
+
+/// A fingerprint of the terrain classes and their physics.
+fn patches_digest(p: &verti_world::PatchGrid) -> u64 {
+    let mut h = 0u64;
+    for (i, patch) in p.patches().iter().enumerate() {
+        h = verti_core::rng::mix_seed(&[
+            h,
+            i as u64,
+            u64::from(patch.class.id()),
+            patch.surface.effective_friction().to_bits(),
+        ]);
+    }
+    h
 }
 
 /// A cheap fingerprint of a heightfield (two worlds of one name never share a map).

@@ -37,6 +37,34 @@ pub struct Footprint {
     pub vegetation: [f64; 4],
     /// Fraction r_veg ∈ [0, 1] of vegetation in the footprint; r_dirt = 1 − r_veg (eq. 18).
     pub veg_fraction: f64,
+    /// Ground friction under each wheel (Coulomb μ of rigid ground, tan φ of soil). The paper's
+    /// maps are all dirt ([`DIRT_FRICTION`]); verti's ten classes scale the slope limits by it
+    /// (see [`slope_limit`]).
+    #[serde(default = "dirt_everywhere")]
+    pub friction: [f64; 4],
+}
+
+/// Friction of the paper's dirt (verti's dirt class mean): the ground the slope limits s_max
+/// were measured on.
+pub const DIRT_FRICTION: f64 = 0.6;
+
+fn dirt_everywhere() -> [f64; 4] {
+    [DIRT_FRICTION; 4]
+}
+
+/// The slope limit of eq. 15 on ground of friction `mu`: `limit` (measured on dirt) scaled by
+/// atan(μ) / atan(μ_dirt), because the steepest slope a wheel can climb before it slides grows
+/// as atan(μ) (the friction angle). On dirt it is `limit` exactly; on grass (μ 0.36) a 30°
+/// limit becomes 19.2°, on concrete (0.85) 39.3°. A NaN or non-positive μ gives 0: no traction.
+#[inline(always)]
+pub fn slope_limit(limit: f64, mu: f64) -> f64 {
+    if mu == DIRT_FRICTION {
+        return limit;
+    }
+    if mu.is_nan() || mu <= 0.0 {
+        return 0.0;
+    }
+    limit * (mu.atan() / DIRT_FRICTION.atan())
 }
 
 /// Constants of the prior. The defaults are the paper's: s_max = 30° (linear) and 15° (angular)
@@ -79,9 +107,9 @@ fn unit(x: f64, nan_as: f64) -> f64 {
 /// One-hot traction PMFs of four wheels, ¼ each, from a per-wheel "how far to the limit" value.
 /// A NaN traction (bad measurement, or a non-positive limit) is taken as 0, the pessimistic end.
 #[inline(always)]
-fn wheel_traction(quantity: &[f64; 4], limit: f64, bins: &Bins) -> Pmf {
+fn wheel_traction(quantity: &[f64; 4], limits: &[f64; 4], bins: &Bins) -> Pmf {
     let mut p = [0.0; B];
-    for &q in quantity {
+    for (&q, &limit) in quantity.iter().zip(limits) {
         let t = unit((limit - q) / limit, 0.0);
         p[bins.index(t)] += 0.25;
     }
@@ -93,7 +121,18 @@ fn wheel_traction(quantity: &[f64; 4], limit: f64, bins: &Bins) -> Pmf {
 /// heading. NaN slopes, or s_max ≤ 0, give traction 0 (the pessimistic end).
 #[inline(always)]
 pub fn dirt_traction(slopes: &[f64; 4], max_slope: f64, bins: &Bins) -> Pmf {
-    wheel_traction(&slopes.map(f64::abs), max_slope, bins)
+    wheel_traction(&slopes.map(f64::abs), &[max_slope; 4], bins)
+}
+
+/// Eq. 15 on ground of any class: each wheel's slope limit is s_max scaled by its ground's
+/// friction ([`slope_limit`]). With dirt under every wheel it is [`dirt_traction`], bit for bit.
+#[inline(always)]
+pub fn ground_traction(slopes: &[f64; 4], max_slope: f64, friction: &[f64; 4], bins: &Bins) -> Pmf {
+    wheel_traction(
+        &slopes.map(f64::abs),
+        &friction.map(|mu| slope_limit(max_slope, mu)),
+        bins,
+    )
 }
 
 /// Vegetation traction prior of eq. 16: each wheel contributes ¼ on the bin of
@@ -101,7 +140,7 @@ pub fn dirt_traction(slopes: &[f64; 4], max_slope: f64, bins: &Bins) -> Pmf {
 /// or h_max ≤ 0, give traction 0.
 #[inline(always)]
 pub fn vegetation_traction(vegetation: &[f64; 4], max_height: f64, bins: &Bins) -> Pmf {
-    wheel_traction(vegetation, max_height, bins)
+    wheel_traction(vegetation, &[max_height; 4], bins)
 }
 
 /// Roll or pitch prior of eq. 17: each wheel pair contributes ½ on the bin of
@@ -142,7 +181,7 @@ pub fn physics_prior(fp: &Footprint, cfg: &PriorConfig, bins: &[Bins; PARAMS]) -
     let limits = [cfg.max_slope_linear, cfg.max_slope_angular];
     let semantic: [Pmf; PARAMS] = std::array::from_fn(|k| match k {
         0 | 1 => {
-            let dirt = dirt_traction(&fp.slopes, limits[k], &bins[k]);
+            let dirt = ground_traction(&fp.slopes, limits[k], &fp.friction, &bins[k]);
             let veg = vegetation_traction(&fp.vegetation, cfg.max_vegetation, &bins[k]);
             std::array::from_fn(|b| r_dirt * dirt[b] + r_veg * veg[b])
         }
@@ -178,6 +217,7 @@ mod tests {
             wheelbase: WHEELBASE,
             vegetation: [0.0; 4],
             veg_fraction: 0.0,
+            friction: [DIRT_FRICTION; 4],
         }
     }
 
@@ -277,6 +317,32 @@ mod tests {
     }
 
     #[test]
+    fn friction_scales_the_slope_limit() {
+        let cfg = PriorConfig::default();
+        let bins = param_bins();
+        // 15° uphill: dirt keeps (30 − 15)/30 = 0.5 of its traction (bin 6 of 12)
+        let mut fp = on_plane(0.0, 15f64.to_radians());
+        let dirt = physics_prior(&fp, &cfg, &bins);
+        peak(&dirt[0], 6, 0.2);
+        // grass (μ 0.36): the limit is 30° · atan 0.36 / atan 0.6 = 19.19°, so 0.218 (bin 2)
+        fp.friction = [0.36; 4];
+        let limit = slope_limit(30f64.to_radians(), 0.36).to_degrees();
+        assert!((limit - 30.0 * 0.36f64.atan() / 0.6f64.atan()).abs() < 1e-12);
+        assert!((limit - 19.19).abs() < 0.01, "{limit}");
+        let grass = physics_prior(&fp, &cfg, &bins);
+        peak(&grass[0], 2, 0.2);
+        // concrete (μ 0.85): 39.3°, so 0.618 (bin 7); attitude does not depend on the ground
+        fp.friction = [0.85; 4];
+        let concrete = physics_prior(&fp, &cfg, &bins);
+        peak(&concrete[0], 7, 0.2);
+        assert_eq!(concrete[3], dirt[3]);
+        // dirt under every wheel is the paper's prior, bit for bit
+        fp.friction = [DIRT_FRICTION; 4];
+        assert_eq!(physics_prior(&fp, &cfg, &bins), dirt);
+        assert_eq!(slope_limit(0.5, f64::NAN), 0.0);
+    }
+
+    #[test]
     fn always_a_pmf() {
         let mut rng = Rng::new(21);
         let bins = param_bins();
@@ -294,6 +360,7 @@ mod tests {
                 wheelbase: rng.range(0.3, 4.0),
                 vegetation: std::array::from_fn(|_| rng.range(0.0, 0.4)),
                 veg_fraction: rng.range(-0.2, 1.2),
+                friction: std::array::from_fn(|_| rng.range(-0.1, 1.0)),
             };
             let cfg = PriorConfig {
                 w_uniform: rng.range(-0.5, 1.5),
@@ -309,6 +376,7 @@ mod tests {
             wheelbase: f64::NAN,
             vegetation: [f64::NAN; 4],
             veg_fraction: f64::NAN,
+            friction: [f64::NAN; 4],
         };
         let cfg = PriorConfig {
             max_slope_linear: 0.0,

@@ -69,6 +69,11 @@ fn params() -> Vec<ParamSpec> {
             false,
             "plan with the physics prior alone (no learned model)",
         ),
+        ParamSpec::bool(
+            "semantics",
+            false,
+            "semantics-aware prior (beyond the paper's dirt-only maps): each wheel's slope limit scales with the friction of its terrain class",
+        ),
         ParamSpec::float(
             "w_ood",
             t.ood,
@@ -127,7 +132,8 @@ impl Factory<dyn MobilitySystem> for PietraSystem {
             track: 1.8,
             wheelbase: 3.4,
         };
-        let model = CvarRollout::new(source, layout, p.float("alpha"), p.float("cell"));
+        let model = CvarRollout::new(source, layout, p.float("alpha"), p.float("cell"))
+            .with_semantics(p.bool("semantics"));
         Ok(Box::new(Mppi::with_model(
             "pietra",
             mppi,

@@ -122,9 +122,11 @@ fn pietra_drives_a_training_map_task() {
     verti_pietra::system::register(&mut registry, verti_pietra::shipped::pietra_v1).unwrap();
     let world = Arc::new(map(Split::Train, 2));
     let spec = verti_sim::vehicles::builtin("hmmwv").unwrap();
-    for prior_only in [true, false] {
+    // the semantics-aware prior too (these maps are dirt, so it plans as the plain one)
+    for (prior_only, semantics) in [(true, false), (false, false), (false, true)] {
         let given = [
             ("prior_only".to_string(), ParamValue::Bool(prior_only)),
+            ("semantics".to_string(), ParamValue::Bool(semantics)),
             ("speed".to_string(), ParamValue::Float(2.0)),
             ("lookahead".to_string(), ParamValue::Float(60.0)),
             // a light planner keeps the test quick; the dynamics and cost are the same
@@ -145,7 +147,7 @@ fn pietra_drives_a_training_map_task() {
         assert_eq!(
             r.outcome,
             Outcome::Success,
-            "prior_only {prior_only}: {r:?}"
+            "prior_only {prior_only}, semantics {semantics}: {r:?}"
         );
     }
 }
