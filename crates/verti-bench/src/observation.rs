@@ -312,4 +312,39 @@ mod tests {
         );
         assert!((crop.get(2, 4) - here - 0.2).abs() < 1e-9);
     }
+
+    #[test]
+    fn sensing_limits_what_the_crops_show() {
+        // a plane rising to the east, z = 0.1 x; the vehicle at the origin facing east
+        let world = testing::plane_world(1.0, 0.1f64.atan(), 0.0, 0.8);
+        let spec = CropSpec {
+            size: 41,
+            resolution: 1.0,
+        };
+        let obs = || test_observation(&world, [0.0, 0.0], 0.0, [10.0, 0.0], &[]);
+        let sensing = Sensing {
+            centre: [0.0, 0.0],
+            range: 10.0,
+            ground: 0.0,
+            shift: [2.0, 0.0],
+        };
+        let plain = obs().elevation_crop(spec);
+        let seen = obs().with_sensing(sensing).elevation_crop(spec);
+        // row 0 is 20 m ahead: beyond range, level ground at the vehicle's height
+        assert_eq!(seen.get(0, 20), 0.0);
+        assert!((plain.get(0, 20) - 2.0).abs() < 1e-9);
+        // 5 m ahead (row 15) is in range, read 2 m behind where it is (the latency shift)
+        assert!((seen.get(15, 20) - 0.3).abs() < 1e-9, "{}", seen.get(15, 20));
+        assert!((obs().with_sensing(sensing).elevation_at(5.0, 0.0) - 0.3).abs() < 1e-9);
+        // beyond range nothing is an obstacle, but the map's edge still is
+        let occ = obs().with_sensing(sensing).occupancy_crop(spec);
+        assert_eq!(occ.get(0, 20), 0);
+        assert_eq!(obs().with_sensing(sensing).obstacle_distance(50.0, 0.0), f64::INFINITY);
+        let far = CropSpec {
+            size: 9,
+            resolution: 100.0,
+        };
+        let edge = obs().with_sensing(sensing).occupancy_crop(far);
+        assert_eq!(edge.get(0, 4), 1, "off the map reads occupied even out of range");
+    }
 }
