@@ -117,11 +117,18 @@ pub fn system_color(name: &str) -> Option<Rgb<u8>> {
 }
 
 /// Colour of the `i`-th distinct series name: its system's, else the `i`-th series colour.
+/// Variants of one system (`pid`, `pid [perception=high]`, ...) share its hue, each later one
+/// a shade darker, so they stay apart side by side.
 fn name_color(names: &[&str], i: usize) -> Rgb<u8> {
-    names
-        .get(i)
-        .and_then(|n| system_color(n))
-        .unwrap_or_else(|| series_color(i))
+    let Some(base) = names.get(i).and_then(|n| system_color(n)) else {
+        return series_color(i);
+    };
+    let earlier = names[..i]
+        .iter()
+        .filter(|n| system_color(n) == Some(base))
+        .count();
+    let keep = 1.0 - (0.22 * earlier as f64).min(0.66);
+    Rgb(base.0.map(|c| (f64::from(c) * keep).round() as u8))
 }
 
 /// Distinct series names over all panels, in first-seen order (the legend, and the index of
@@ -705,5 +712,25 @@ mod tests {
             (PANEL_WIDTH, legend_height(1) + PANEL_HEIGHT)
         );
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn variants_of_one_system_get_darker_shades_of_its_hue() {
+        let names = [
+            "pid",
+            "pid [perception=low]",
+            "mcl",
+            "pid [perception=high]",
+        ];
+        let c: Vec<Rgb<u8>> = (0..names.len()).map(|i| name_color(&names, i)).collect();
+        assert_eq!(c[0], system_color("pid").unwrap());
+        assert_eq!(c[2], system_color("mcl").unwrap());
+        let lum = |c: Rgb<u8>| c.0.iter().map(|&v| u32::from(v)).sum::<u32>();
+        assert!(lum(c[0]) > lum(c[1]) && lum(c[1]) > lum(c[3]));
+        assert!(
+            c.iter()
+                .enumerate()
+                .all(|(i, a)| c[i + 1..].iter().all(|b| a != b))
+        );
     }
 }
