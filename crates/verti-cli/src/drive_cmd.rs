@@ -13,6 +13,9 @@ use verti_drive::server::{ServeOptions, serve};
 use verti_drive::{DemoInfo, DriveSession};
 use verti_world::World;
 
+/// Raised by Ctrl-C while the live view runs.
+static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
 #[derive(Args)]
 pub struct DriveArgs {
     /// World set (as `verti eval --worlds`).
@@ -119,15 +122,27 @@ pub fn drive(a: DriveArgs) -> CmdResult {
                 .map_err(|e| format!("--port {}: cannot listen on 127.0.0.1: {e}", a.port))?;
             let addr = listener.local_addr()?;
             println!(
-                "live view: open http://{addr}/ in a browser ({}; Ctrl-C stops without saving)",
+                "live view: open http://{addr}/ in a browser ({}; Ctrl-C stops and saves)",
                 if a.system.is_some() {
                     "watch the system drive"
                 } else {
                     "drive with the arrow keys or WASD, space stops; a gamepad works too"
                 }
             );
+            // Ctrl-C ends the session like the page's Stop button: what was driven is saved
+            extern "C" fn on_interrupt(_: libc::c_int) {
+                STOP.store(true, std::sync::atomic::Ordering::SeqCst);
+            }
+            // SAFETY: the handler only stores to an atomic, which is async-signal-safe
+            unsafe {
+                libc::signal(
+                    libc::SIGINT,
+                    on_interrupt as extern "C" fn(libc::c_int) as libc::sighandler_t,
+                );
+            }
             let opts = ServeOptions {
                 speed: a.speed,
+                stop: Some(&STOP),
                 ..Default::default()
             };
             serve(session, &listener, opts)?

@@ -17,6 +17,8 @@ pub struct ServeOptions {
     pub speed: f64,
     /// End the session when the page has not asked for this long (a closed tab).
     pub idle: Duration,
+    /// Raised (e.g. by a Ctrl-C handler) to end the session: it is saved as it stands.
+    pub stop: Option<&'static std::sync::atomic::AtomicBool>,
 }
 
 impl Default for ServeOptions {
@@ -24,6 +26,7 @@ impl Default for ServeOptions {
         ServeOptions {
             speed: 1.0,
             idle: Duration::from_secs(30),
+            stop: None,
         }
     }
 }
@@ -85,6 +88,12 @@ pub fn serve(
     let mut last_request = Instant::now();
     let mut end_seen = false;
     loop {
+        if opts
+            .stop
+            .is_some_and(|s| s.load(std::sync::atomic::Ordering::SeqCst))
+        {
+            break;
+        }
         let (mut stream, _) = match listener.accept() {
             Ok(s) => s,
             Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {

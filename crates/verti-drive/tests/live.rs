@@ -94,6 +94,7 @@ fn the_live_server_steps_in_time_with_the_keys_it_is_sent() {
         let opts = ServeOptions {
             speed: 20.0,
             idle: Duration::from_secs(10),
+            stop: None,
         };
         serve(session, &listener, opts).unwrap()
     });
