@@ -3,33 +3,16 @@
 //! `sedan`) pass the validation tests that apply to them. Every expected number is derived on paper from
 //! the vehicle file; the tolerance is stated in the test.
 
-use std::sync::Arc;
 use verti_core::Vec3;
 use verti_sim::spec::{Differential, VehicleSpec};
-use verti_sim::{Controls, Sim, SimState, StartPose, testing, vehicles};
+use verti_sim::{Controls, Sim, SimState, testing, vehicles};
 use verti_world::World;
 
-const G: f64 = 9.81;
+mod common;
+use common::{G, corner_loads, fit_circle, run};
 
 fn sim_at(world: World, spec: &VehicleSpec) -> (Sim, SimState) {
-    let world = Arc::new(world);
-    let sim = Sim::new(&world, spec).unwrap();
-    let state = sim.state_at(StartPose::new(0.0, 0.0, 0.0)).unwrap();
-    (sim, state)
-}
-
-fn run(sim: &Sim, state: &mut SimState, controls: Controls, seconds: f64) {
-    for _ in 0..(seconds / 0.01).round() as usize {
-        sim.step(state, controls, 0.01).unwrap();
-    }
-}
-
-/// Sprung load per corner of a two-axle vehicle by the lever rule \[N\] (front, rear).
-fn corner_loads(spec: &VehicleSpec) -> (f64, f64) {
-    let (xf, xr) = (spec.axles[0].x, spec.axles[1].x);
-    let w = spec.chassis.mass * G;
-    let front = w * (spec.chassis.com[0] - xr) / (xf - xr);
-    (0.5 * front, 0.5 * (w - front))
+    common::sim_at(world, spec, 0.0, 0.0, 0.0)
 }
 
 /// The paper's list, and every built-in vehicle's place in it.
@@ -357,28 +340,4 @@ fn low_speed_cornering_of_the_new_vehicles() {
             "{name}: radius {radius:.2} m, Ackermann {expected:.2} m"
         );
     }
-}
-
-/// Least-squares (Kåsa) circle through points: its radius.
-fn fit_circle(points: &[(f64, f64)]) -> f64 {
-    let n = points.len() as f64;
-    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
-    let (mut suu, mut svv, mut suv, mut suuu, mut svvv, mut suvv, mut svuu) =
-        (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    for &(x, y) in points {
-        let (u, v) = (x - mx, y - my);
-        suu += u * u;
-        svv += v * v;
-        suv += u * v;
-        suuu += u * u * u;
-        svvv += v * v * v;
-        suvv += u * v * v;
-        svuu += v * u * u;
-    }
-    let (b1, b2) = (0.5 * (suuu + suvv), 0.5 * (svvv + svuu));
-    let det = suu * svv - suv * suv;
-    let uc = (b1 * svv - b2 * suv) / det;
-    let vc = (suu * b2 - suv * b1) / det;
-    (uc * uc + vc * vc + (suu + svv) / n).sqrt()
 }

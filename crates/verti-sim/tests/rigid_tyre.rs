@@ -8,26 +8,13 @@ use verti_core::{Rng, Vec3};
 use verti_sim::spec::{TyreModel, VehicleSpec};
 use verti_sim::testing::{self, RoughSurface};
 use verti_sim::{Controls, Sim, SimState, StartPose, vehicles};
-use verti_world::{SoilParams, World};
+use verti_world::SoilParams;
 
-const G: f64 = 9.81;
+mod common;
+use common::{G, run, sim_at};
 
 fn rigid() -> VehicleSpec {
     vehicles::builtin("hmmwv").unwrap()
-}
-
-fn sim_at(world: World, spec: &VehicleSpec, x: f64, y: f64, yaw: f64) -> (Sim, SimState) {
-    let world = Arc::new(world);
-    let sim = Sim::new(&world, spec).unwrap();
-    let state = sim.state_at(StartPose::new(x, y, yaw)).unwrap();
-    (sim, state)
-}
-
-fn run(sim: &Sim, state: &mut SimState, controls: Controls, seconds: f64) {
-    let n = (seconds / 0.01).round() as usize;
-    for _ in 0..n {
-        sim.step(state, controls, 0.01).unwrap();
-    }
 }
 
 /// Load on each wheel at rest on flat ground \[N\] (front, rear): the sprung weight split by the

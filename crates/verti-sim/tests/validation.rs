@@ -8,34 +8,13 @@ use verti_sim::testing::{self, RoughSurface};
 use verti_sim::{Controls, Sim, SimState, StartPose, vehicles};
 use verti_world::{SoilParams, World};
 
-const G: f64 = 9.81;
+mod common;
+use common::{G, corner_loads, fit_circle, run, sim_at};
 
 /// The HMMWV on the handling tyre, which these derivations are written for (the rigid tyre,
 /// the built-in `hmmwv`, has its own in `rigid_tyre.rs`).
 fn hmmwv() -> VehicleSpec {
     vehicles::builtin("hmmwv-handling").unwrap()
-}
-
-fn sim_at(world: World, spec: &VehicleSpec, x: f64, y: f64, yaw: f64) -> (Sim, SimState) {
-    let world = Arc::new(world);
-    let sim = Sim::new(&world, spec).unwrap();
-    let state = sim.state_at(StartPose::new(x, y, yaw)).unwrap();
-    (sim, state)
-}
-
-fn run(sim: &Sim, state: &mut SimState, controls: Controls, seconds: f64) {
-    let n = (seconds / 0.01).round() as usize;
-    for _ in 0..n {
-        sim.step(state, controls, 0.01).unwrap();
-    }
-}
-
-/// Sprung load per corner of a two-axle vehicle by the lever rule [N] (front, rear).
-fn corner_loads(spec: &VehicleSpec) -> (f64, f64) {
-    let (xf, xr) = (spec.axles[0].x, spec.axles[1].x);
-    let w = spec.chassis.mass * G;
-    let front = w * (spec.chassis.com[0] - xr) / (xf - xr);
-    (0.5 * front, 0.5 * (w - front))
 }
 
 // 1. Static sag per corner = m·g/k (sprung corner load by the lever rule over the spring rate),
@@ -375,32 +354,6 @@ fn stuck_in_snow_on_a_slope_it_climbs_on_concrete() {
         "on concrete it only climbed {concrete:.2} m"
     );
     assert!(snow < 2.0, "on snow it climbed {snow:.2} m");
-}
-
-/// Least-squares (Kåsa) circle through points: returns the radius.
-fn fit_circle(points: &[(f64, f64)]) -> f64 {
-    let n = points.len() as f64;
-    let (mx, my) = (
-        points.iter().map(|p| p.0).sum::<f64>() / n,
-        points.iter().map(|p| p.1).sum::<f64>() / n,
-    );
-    let (mut suu, mut svv, mut suv, mut suuu, mut svvv, mut suvv, mut svuu) =
-        (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    for &(x, y) in points {
-        let (u, v) = (x - mx, y - my);
-        suu += u * u;
-        svv += v * v;
-        suv += u * v;
-        suuu += u * u * u;
-        svvv += v * v * v;
-        suvv += u * v * v;
-        svuu += v * u * u;
-    }
-    let (b1, b2) = (0.5 * (suuu + suvv), 0.5 * (svvv + svuu));
-    let det = suu * svv - suv * suv;
-    let uc = (b1 * svv - b2 * suv) / det;
-    let vc = (suu * b2 - suv * b1) / det;
-    (uc * uc + vc * vc + (suu + svv) / n).sqrt()
 }
 
 // 6. Steady low-speed cornering follows Ackermann geometry: with bicycle steer angle δ (half
