@@ -334,17 +334,28 @@ mod tests {
         assert_eq!(seen.get(0, 20), 0.0);
         assert!((plain.get(0, 20) - 2.0).abs() < 1e-9);
         // 5 m ahead (row 15) is in range, read 2 m behind where it is (the latency shift)
-        assert!((seen.get(15, 20) - 0.3).abs() < 1e-9, "{}", seen.get(15, 20));
+        assert!(
+            (seen.get(15, 20) - 0.3).abs() < 1e-9,
+            "{}",
+            seen.get(15, 20)
+        );
         assert!((obs().with_sensing(sensing).elevation_at(5.0, 0.0) - 0.3).abs() < 1e-9);
         // beyond range nothing is an obstacle, but the map's edge still is
         let occ = obs().with_sensing(sensing).occupancy_crop(spec);
         assert_eq!(occ.get(0, 20), 0);
-        assert_eq!(obs().with_sensing(sensing).obstacle_distance(50.0, 0.0), f64::INFINITY);
+        assert_eq!(
+            obs().with_sensing(sensing).obstacle_distance(50.0, 0.0),
+            f64::INFINITY
+        );
         let far = CropSpec {
             size: 9,
             resolution: 100.0,
         };
         let edge = obs().with_sensing(sensing).occupancy_crop(far);
-        assert_eq!(edge.get(0, 4), 1, "off the map reads occupied even out of range");
+        assert_eq!(
+            edge.get(0, 4),
+            1,
+            "off the map reads occupied even out of range"
+        );
     }
 }
