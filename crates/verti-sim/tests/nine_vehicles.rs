@@ -9,7 +9,7 @@ use verti_sim::{Controls, Sim, SimState, testing, vehicles};
 use verti_world::World;
 
 mod common;
-use common::{G, corner_loads, fit_circle, run};
+use common::{G, corner_loads, fit_circle, max_roll, run};
 
 fn sim_at(world: World, spec: &VehicleSpec) -> (Sim, SimState) {
     common::sim_at(world, spec, 0.0, 0.0, 0.0)
@@ -205,16 +205,7 @@ fn max_roll_parked_across(spec: &VehicleSpec, deg: f64, mu: f64) -> f64 {
     let mut spec = spec.clone();
     spec.tyre.friction = mu;
     let (sim, mut st) = sim_at(testing::plane_world(1.0, 0.0, deg.to_radians(), mu), &spec);
-    let mut worst: f64 = 0.0;
-    for _ in 0..400 {
-        sim.step(&mut st, Controls::new(0.0, 1.0, 0.0), 0.01)
-            .unwrap();
-        worst = worst.max(st.euler().0.abs());
-        if st.is_rolled_over() {
-            return std::f64::consts::PI;
-        }
-    }
-    worst
+    max_roll(&sim, &mut st, Controls::new(0.0, 1.0, 0.0), 400)
 }
 
 // Tilt table: a rigid vehicle tips when gravity's line passes the downhill tipping axis, the

@@ -11,7 +11,7 @@ use verti_sim::{Controls, Sim, SimState, StartPose, vehicles};
 use verti_world::SoilParams;
 
 mod common;
-use common::{G, run, sim_at};
+use common::{G, max_roll, run, sim_at};
 
 fn rigid() -> VehicleSpec {
     vehicles::builtin("hmmwv").unwrap()
@@ -305,16 +305,7 @@ fn static_com_height(spec: &VehicleSpec) -> f64 {
 fn max_roll_on_side_slope(spec: &VehicleSpec, deg: f64) -> f64 {
     let world = testing::plane_world(1.0, 0.0, deg.to_radians(), 2.0);
     let (sim, mut st) = sim_at(world, spec, 0.0, 0.0, 0.0);
-    let mut worst: f64 = 0.0;
-    for _ in 0..400 {
-        sim.step(&mut st, Controls::new(0.0, 1.0, 0.0), 0.01)
-            .unwrap();
-        worst = worst.max(st.euler().0.abs());
-        if st.is_rolled_over() {
-            return std::f64::consts::PI;
-        }
-    }
-    worst
+    max_roll(&sim, &mut st, Controls::new(0.0, 1.0, 0.0), 400)
 }
 
 // 7. Tilt table (validation test 3 for the rigid tyre): a rigid vehicle tips when the resultant

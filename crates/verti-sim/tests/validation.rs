@@ -9,7 +9,7 @@ use verti_sim::{Controls, Sim, SimState, StartPose, vehicles};
 use verti_world::{SoilParams, World};
 
 mod common;
-use common::{G, corner_loads, fit_circle, run, sim_at};
+use common::{G, corner_loads, fit_circle, max_roll, run, sim_at};
 
 /// The HMMWV on the handling tyre, which these derivations are written for (the rigid tyre,
 /// the built-in `hmmwv`, has its own in `rigid_tyre.rs`).
@@ -188,15 +188,7 @@ fn max_roll_on_side_slope(spec: &VehicleSpec, deg: f64, seconds: f64, controls: 
         0.0,
         0.0,
     );
-    let mut worst: f64 = 0.0;
-    for _ in 0..(seconds / 0.01) as usize {
-        sim.step(&mut st, controls, 0.01).unwrap();
-        worst = worst.max(st.euler().0.abs());
-        if st.is_rolled_over() {
-            return std::f64::consts::PI;
-        }
-    }
-    worst
+    max_roll(&sim, &mut st, controls, (seconds / 0.01) as usize)
 }
 
 // 3. Tilt table: a rigid vehicle tips when the resultant of gravity passes the downhill wheels,

@@ -24,6 +24,20 @@ pub fn run(sim: &Sim, state: &mut SimState, controls: Controls, seconds: f64) {
     }
 }
 
+/// Largest |roll| (rad) over `steps` 10-ms steps holding `controls`; π as soon as the vehicle
+/// has rolled over (a tipping vehicle goes on to 180°).
+pub fn max_roll(sim: &Sim, state: &mut SimState, controls: Controls, steps: usize) -> f64 {
+    let mut worst: f64 = 0.0;
+    for _ in 0..steps {
+        sim.step(state, controls, 0.01).unwrap();
+        worst = worst.max(state.euler().0.abs());
+        if state.is_rolled_over() {
+            return std::f64::consts::PI;
+        }
+    }
+    worst
+}
+
 /// Sprung load per corner of a two-axle vehicle by the lever rule \[N\] (front, rear).
 pub fn corner_loads(spec: &VehicleSpec) -> (f64, f64) {
     let (xf, xr) = (spec.axles[0].x, spec.axles[1].x);
