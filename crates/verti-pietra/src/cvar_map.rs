@@ -124,9 +124,9 @@ pub fn footprint_cvar(
 ) -> ([f64; PARAMS], bool) {
     let mut fp = footprint(terrain, &spec.layout, x, y, yaw);
     if spec.surface.is_some() {
-        let (s, c) = yaw.sin_cos();
         for (k, w) in spec.layout.wheels.iter().enumerate() {
-            fp.friction[k] = spec.friction_at(x + w[0] * c - w[1] * s, y + w[0] * s + w[1] * c);
+            let (wx, wy) = crate::dataset::offset(x, y, yaw, w[0], w[1]);
+            fp.friction[k] = spec.friction_at(wx, wy);
         }
     }
     let physics = physics_prior(&fp, &spec.prior, &spec.bins);

@@ -69,7 +69,7 @@ impl WheelLayout {
 
 /// A point `forward` ahead and `left` to the left of (x, y) facing `yaw`.
 #[inline]
-fn offset(x: f64, y: f64, yaw: f64, forward: f64, left: f64) -> (f64, f64) {
+pub(crate) fn offset(x: f64, y: f64, yaw: f64, forward: f64, left: f64) -> (f64, f64) {
     let (s, c) = yaw.sin_cos();
     (x + forward * c - left * s, y + forward * s + left * c)
 }
