@@ -179,13 +179,9 @@ impl<'a> Observation<'a> {
     /// Semantic class id (Verti-Bench label ids 0..9) under each cell; out of sensing range,
     /// the class under the vehicle.
     pub fn semantic_crop(&self, spec: CropSpec) -> Crop<u8> {
-        self.crop(spec, |x, y| match &self.sensing {
-            None => self.world.patches.at(x, y).class.id(),
-            Some(s) if s.sees(x, y) => {
-                let (x, y) = s.lookup(x, y);
-                self.world.patches.at(x, y).class.id()
-            }
-            Some(s) => self.world.patches.at(s.centre[0], s.centre[1]).class.id(),
+        self.crop(spec, |x, y| {
+            let (x, y) = self.sensed(x, y).unwrap_or_else(|| self.vehicle_xy());
+            self.world.patches.at(x, y).class.id()
         })
     }
 
@@ -210,10 +206,8 @@ impl<'a> Observation<'a> {
         self.crop(spec, |x, y| {
             let off_map = !self.world.terrain.contains(x, y);
             // under perception noise: nothing is known beyond range, and reads lag by the latency
-            let (x, y) = match &self.sensing {
-                None => (x, y),
-                Some(s) if s.sees(x, y) => s.lookup(x, y),
-                Some(_) => return u8::from(off_map),
+            let Some((x, y)) = self.sensed(x, y) else {
+                return u8::from(off_map);
             };
             u8::from(
                 off_map
@@ -230,27 +224,35 @@ impl<'a> Observation<'a> {
     /// Undeformed terrain height at a world point (ground truth, as the paper's systems get;
     /// under perception noise, the perceived map within sensing range, level ground beyond).
     pub fn elevation_at(&self, x: f64, y: f64) -> f64 {
-        match &self.sensing {
-            None => self.world.terrain.height_at(x, y),
-            Some(s) if s.sees(x, y) => {
-                let (x, y) = s.lookup(x, y);
-                self.world.terrain.height_at(x, y)
-            }
-            Some(s) => s.ground,
-        }
+        // beyond sensing range: level ground at the vehicle
+        self.sensed(x, y).map_or_else(
+            || self.sensing.map_or(0.0, |s| s.ground),
+            |(x, y)| self.world.terrain.height_at(x, y),
+        )
     }
 
     /// Horizontal distance from (x, y) to the nearest obstacle footprint (negative inside);
     /// under perception noise, infinite beyond sensing range.
     pub fn obstacle_distance(&self, x: f64, y: f64) -> f64 {
+        self.sensed(x, y)
+            .map_or(f64::INFINITY, |(x, y)| self.world.obstacle_distance(x, y))
+    }
+
+    /// Where a map read at (x, y) lands: the point itself with ideal sensing; under perception
+    /// noise the point displaced by the latency shift, or None beyond sensing range.
+    #[inline]
+    fn sensed(&self, x: f64, y: f64) -> Option<(f64, f64)> {
         match &self.sensing {
-            None => self.world.obstacle_distance(x, y),
-            Some(s) if s.sees(x, y) => {
-                let (x, y) = s.lookup(x, y);
-                self.world.obstacle_distance(x, y)
-            }
-            Some(_) => f64::INFINITY,
+            None => Some((x, y)),
+            Some(s) => s.sees(x, y).then(|| s.lookup(x, y)),
         }
+    }
+
+    /// Where reads beyond sensing range look: the vehicle's true place (only sensing puts a
+    /// point out of range; without it, the observed pose).
+    fn vehicle_xy(&self) -> (f64, f64) {
+        self.sensing
+            .map_or((self.pose.x, self.pose.y), |s| (s.centre[0], s.centre[1]))
     }
 
     /// Half of the map's side length (m): the map spans [-h, h] in x and y.

@@ -68,7 +68,6 @@ struct EstimateError {
 pub struct Perception {
     model: Arc<PerceptionModel>,
     world: Arc<World>,
-    scale: f64,
     rng: Rng,
     /// Random-walk drift of x, y (m) and yaw (rad).
     drift: [f64; 3],
@@ -80,7 +79,6 @@ impl Perception {
     pub fn new(world: &World, model: Arc<PerceptionModel>, seed: u64) -> Perception {
         let perceived = map::perceived_world(world, &model, seed);
         let mut p = Perception {
-            scale: world.meta.scale,
             world: Arc::new(perceived),
             rng: Rng::derive(seed, "perception.estimate", 0),
             drift: [0.0; 3],
@@ -102,7 +100,7 @@ impl Perception {
 
     fn draw_white(&mut self) -> EstimateError {
         let m = &self.model;
-        let (s, d) = (self.scale, std::f64::consts::PI / 180.0);
+        let (s, d) = (self.world.meta.scale, std::f64::consts::PI / 180.0);
         let rng = &mut self.rng;
         let mut g = |sigma: f64| {
             if sigma > 0.0 {
@@ -139,7 +137,7 @@ impl Perception {
         let m = &self.model;
         let root = dt.max(0.0).sqrt();
         let (xy, yaw) = (
-            m.pose.position_drift * self.scale * root,
+            m.pose.position_drift * self.world.meta.scale * root,
             m.pose.yaw_drift_deg.to_radians() * root,
         );
         if xy > 0.0 {
@@ -183,7 +181,7 @@ impl Perception {
         Sensing {
             centre: [truth.x, truth.y],
             range: if e.range > 0.0 {
-                e.range * self.scale
+                e.range * self.world.meta.scale
             } else {
                 f64::INFINITY
             },
