@@ -96,9 +96,16 @@ pub fn drive(a: DriveArgs) -> CmdResult {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("demos").join(format!("task-{}", a.task)));
-    if out.join(verti_data::manifest::MANIFEST).exists() && !a.force {
+    // the dataset writer refuses a non-empty directory without --force: check before anyone
+    // drives, so no drive is lost to it at the end
+    let occupied = out.exists()
+        && std::fs::read_dir(&out)
+            .map_err(|e| format!("--out {}: {e}", out.display()))?
+            .next()
+            .is_some();
+    if occupied && !a.force {
         return Err(format!(
-            "{} already holds a demonstration: pass --force to replace it, or choose another --out",
+            "{} is not empty (a demonstration already there?): pass --force to replace it, or choose another --out",
             out.display()
         )
         .into());
