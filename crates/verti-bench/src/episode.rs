@@ -12,7 +12,7 @@
 use crate::features::{Feature, STEP_LOG};
 use crate::metrics::{AngleStats, SignalStats};
 use crate::observation::Pose6;
-use crate::system::MobilitySystem;
+use crate::system::{Action, MobilitySystem};
 use crate::trial::{Trial, failed_result};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -377,6 +377,30 @@ pub fn run_episode(
     run_episode_watched(world, spec, pair, system, cfg, log, &mut |_| {})
 }
 
+/// The period (s) between a system's actions, from its control rate, or why the rate is not one
+/// (not finite, not positive, above 1 kHz).
+pub fn control_period(system: &dyn MobilitySystem) -> Result<f64, String> {
+    let rate = system.control_rate();
+    if !(rate.is_finite() && rate > 0.0 && rate <= 1000.0) {
+        return Err(format!(
+            "system {} has an invalid control rate {rate} Hz",
+            system.name()
+        ));
+    }
+    Ok(1.0 / rate)
+}
+
+/// The system's action on the trial's current observation; None when the system reports a
+/// failure, which ends the trial as an error naming it.
+pub fn next_action(trial: &mut Trial, system: &mut dyn MobilitySystem) -> Option<Action> {
+    let action = system.act(&trial.observation());
+    if let Some(message) = system.failure() {
+        trial.abort(format!("system {} failed: {message}", system.name()));
+        return None;
+    }
+    Some(action)
+}
+
 /// [`run_episode`], showing `watch` the trial at its start and after every control period
 /// (3-D recordings, live views). Watching changes nothing: the result is the same bits.
 pub fn run_episode_watched(
@@ -411,20 +435,12 @@ pub fn run_episode_watched(
         Err(e) => return failed(e),
     };
     system.reset(trial.info());
-    let rate = system.control_rate();
-    if !(rate.is_finite() && rate > 0.0 && rate <= 1000.0) {
-        return failed(format!(
-            "system {name} has an invalid control rate {rate} Hz"
-        ));
-    }
-    let period = 1.0 / rate;
+    let period = match control_period(system) {
+        Ok(p) => p,
+        Err(e) => return failed(e),
+    };
     watch(&trial);
-    loop {
-        let action = system.act(&trial.observation());
-        if let Some(message) = system.failure() {
-            trial.abort(format!("system {name} failed: {message}"));
-            break;
-        }
+    while let Some(action) = next_action(&mut trial, system) {
         let ended = trial.step(action, period).ended.is_some();
         watch(&trial);
         if ended {

@@ -396,13 +396,8 @@ fn run_task(
     let mut trial = Trial::new(world, sim_for(w)?, pair, &episode, name)?;
     let mut system = make();
     system.reset(trial.info());
-    let rate = system.control_rate();
-    if !(rate.is_finite() && rate > 0.0 && rate <= 1000.0) {
-        return Err(format!(
-            "system {name} has an invalid control rate {rate} Hz"
-        ));
-    }
-    let (rows, outcome) = drive(&mut trial, cfg.rate, 1.0 / rate, None, &mut |t| {
+    let period = verti_bench::episode::control_period(system.as_ref())?;
+    let (rows, outcome) = drive(&mut trial, cfg.rate, period, None, &mut |t| {
         system.act(&t.observation())
     });
     Ok(TrialRecord {

@@ -56,13 +56,8 @@ impl DriveSession {
             ),
             Some(mut s) => {
                 s.reset(trial.info());
-                let rate = s.control_rate();
-                if !(rate.is_finite() && rate > 0.0 && rate <= 1000.0) {
-                    return Err(format!(
-                        "system {who} has an invalid control rate {rate} Hz"
-                    ));
-                }
-                (Pilot::System(s), 1.0 / rate)
+                let period = verti_bench::episode::control_period(s.as_ref())?;
+                (Pilot::System(s), period)
             }
         };
         let mut recording = Recording::start(world, spec, pair, cfg);
@@ -113,12 +108,9 @@ impl DriveSession {
                 Action::HighLevel { speed, steering }
             }
             Pilot::System(s) => {
-                let a = s.act(&self.trial.observation());
-                if let Some(message) = s.failure() {
-                    self.trial
-                        .abort(format!("system {} failed: {message}", s.name()));
+                let Some(a) = verti_bench::episode::next_action(&mut self.trial, s.as_mut()) else {
                     return self.trial.outcome();
-                }
+                };
                 a
             }
         };
