@@ -1,7 +1,7 @@
 //! The world as a noisy perception stack maps it: built once per trial (map errors persist
 //! through a trial, as a mapped error does), from the true world and a seed.
 
-use super::model::{CLASSES, PerceptionModel};
+use super::model::PerceptionModel;
 use verti_core::Vec3;
 use verti_core::rng::Rng;
 use verti_world::{Heightfield, Obstacle, Patch, PatchGrid, Surface, TerrainClass, World};
@@ -134,7 +134,7 @@ fn confused_patches(
                     break;
                 }
             }
-            if j == truth || j >= CLASSES {
+            if j == truth {
                 return *p;
             }
             let class = TerrainClass::from_id(j as i64).unwrap_or(p.class);
