@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The full evaluations behind the README's tables live in benchmarks/<set>/<system>/: run.json
+# The full evaluations behind the README's tables live in benchmarks/<set>/<system>/ (or deeper,
+# e.g. benchmarks/perception-ablation/<model>/<system>/): run.json
 # and results.jsonl.gz are committed (gzip keeps ~1 MB of JSON lines per run to ~0.1 MB);
 # results.jsonl, the file `verti eval --resume` appends to and `verti report` reads, is not.
 #   bash scripts/benchmarks.sh unpack   # results.jsonl from each .gz (an existing newer one is kept)
@@ -9,16 +10,14 @@ cd "$(dirname "$0")/.."
 what=${1:-}
 case "$what" in
 pack)
-    for f in benchmarks/*/*/results.jsonl; do
-        [ -e "$f" ] || continue
+    find benchmarks -name results.jsonl | sort | while read -r f; do
         # -n: no name or time stamp, so an unchanged file packs to the same bytes
         gzip -9 -n -c "$f" > "$f.gz.tmp" && mv "$f.gz.tmp" "$f.gz"
         echo "packed $f ($(wc -l < "$f") results)"
     done
     ;;
 unpack)
-    for g in benchmarks/*/*/results.jsonl.gz; do
-        [ -e "$g" ] || continue
+    find benchmarks -name results.jsonl.gz | sort | while read -r g; do
         f=${g%.gz}
         if [ -e "$f" ] && [ "$(wc -l < "$f")" -ge "$(gzip -dc "$g" | wc -l)" ]; then
             echo "kept $f (as many results as the archive or more)"

@@ -180,6 +180,17 @@ fn perception_noise_changes_what_systems_see_and_is_recorded() {
     );
     let clean_run = std::fs::read_to_string(clean.join("run.json")).unwrap();
     assert!(!clean_run.contains("perception"), "{clean_run}");
+    // noise on the map alone leaves PID (which reads only its pose) exactly as without noise
+    let map_only = root.join("map-only.yaml");
+    std::fs::write(
+        &map_only,
+        "elevation: {sigma: 0.15, hole_fraction: 0.15, range: 15.0, latency: 0.2}\n\
+         semantics: {confusion: 0.3}\nobstacles: {miss_probability: 0.25, false_per_hectare: 6}\n",
+    )
+    .unwrap();
+    let map_noise = root.join("map-noise");
+    assert!(eval(&map_noise, &["--perception", s(&map_only)]).0);
+    assert_eq!(results(&map_noise), results(&clean));
     // a resume under other noise is refused, naming both
     let (success, text) = eval(&noisy, &["--perception", "low", "--resume"]);
     assert!(

@@ -194,6 +194,12 @@ impl PerceptionModel {
         } == PerceptionModel::default()
     }
 
+    /// True when the state estimate is exact (no pose or velocity noise): only the map is
+    /// perturbed, and systems get the true state bit for bit.
+    pub fn exact_state(&self) -> bool {
+        self.pose == PoseNoise::default() && self.velocity == VelocityNoise::default()
+    }
+
     /// Checks every field; names the first bad one.
     pub fn validate(&self) -> Result<(), String> {
         let non_negative = [

@@ -106,6 +106,34 @@ fn white_pose_noise_matches_sigma_and_is_redrawn() {
 }
 
 #[test]
+fn map_only_noise_leaves_the_state_estimate_exact() {
+    // re-wrapping a yaw moves its last bit for most angles, which is enough to change a
+    // chaotic trial: a model that perturbs only the map must hand the true state through
+    let world = testing::plane_world(1.0, 0.0, 0.0, 0.8);
+    let m = only(|m| {
+        m.elevation.sigma = 0.1;
+        m.obstacles.miss_probability = 0.5;
+    });
+    assert!(m.exact_state() && !m.is_none());
+    let yaws = [0.1, 1.0, -2.5, 3.0];
+    assert!(
+        yaws.iter().any(|&y| wrap(y) != y),
+        "the check needs a yaw that wrapping moves"
+    );
+    let mut p = Perception::new(&world, m, 2);
+    for yaw in yaws {
+        let mut truth = FeatureSource::at_rest(Pose6::default());
+        truth.pose.yaw = yaw;
+        truth.pose.x = 1.25;
+        // bit for bit: the Debug form prints every float exactly (shortest round trip)
+        assert_eq!(format!("{:?}", p.estimate(&truth)), format!("{truth:?}"));
+        p.advance(0.05);
+    }
+    assert!(!only(|m| m.pose.yaw_drift_deg = 0.1).exact_state());
+    assert!(!only(|m| m.velocity.linear_sigma = 0.1).exact_state());
+}
+
+#[test]
 fn class_confusion_follows_its_rate() {
     let world = testing::plane_world(1.0, 0.0, 0.0, 0.8);
     let m = only(|m| m.semantics.confusion = 0.25);
