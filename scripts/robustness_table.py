@@ -23,17 +23,32 @@ def order(name):
     return (ORDER.index(name), "") if name in ORDER else (len(ORDER), name)
 
 
-def success(path, tasks=None):
-    """(success %, results counted) of one run's results.jsonl, or None if it does not exist."""
+def outcomes(path, tasks=None):
+    """{task: outcome} of one run's results.jsonl (restricted to `tasks`), or {} if absent."""
     file = Path(path) / "results.jsonl"
     if not file.exists():
-        return None
-    rows = [json.loads(line) for line in file.open() if line.strip()]
-    if tasks is not None:
-        rows = [r for r in rows if r["task"] in tasks]
+        return {}
+    rows = (json.loads(line) for line in file.open() if line.strip())
+    return {r["task"]: r["outcome"] for r in rows if tasks is None or r["task"] in tasks}
+
+
+def success(path, tasks=None):
+    """(success %, results counted) of one run, or None if it has no results."""
+    rows = outcomes(path, tasks)
     if not rows:
         return None
-    return 100.0 * sum(r["outcome"] == "success" for r in rows) / len(rows), len(rows)
+    return 100.0 * sum(o == "success" for o in rows.values()) / len(rows), len(rows)
+
+
+def lost_gained(clean, noisy, tasks=None):
+    """Tasks solved without noise and not with it, and the reverse (on tasks both ran)."""
+    a, b = outcomes(clean, tasks), outcomes(noisy, tasks)
+    both = a.keys() & b.keys()
+    if not both:
+        return "—"
+    lost = sum(a[t] == "success" and b[t] != "success" for t in both)
+    gained = sum(a[t] != "success" and b[t] == "success" for t in both)
+    return f"{lost} / {gained}"
 
 
 def cell(result, expected, digits):
@@ -47,7 +62,8 @@ def cell(result, expected, digits):
 def main(root):
     root = Path(root)
     full, subset = [], []
-    for name in {run.name for run in root.glob("perception-*/*") if run.is_dir()}:
+    names = {r.name for p in PRESETS for r in (root / f"perception-{p}").glob("*") if r.is_dir()}
+    for name in names:
         (subset if name.endswith("-sub100") else full).append(name.removesuffix("-sub100"))
     full.sort(key=order)
     subset.sort(key=order)
@@ -60,18 +76,17 @@ def main(root):
         ]
         print(f"| `{s}` | " + " | ".join(cells) + " |")
     print()
-    print("| system (100 tasks) | " + " | ".join(PRESETS) + " |")
-    print("|---|" + "---:|" * len(PRESETS))
+    print("| system (100 tasks) | " + " | ".join(PRESETS) + " | lost / gained at high |")
+    print("|---|" + "---:|" * (len(PRESETS) + 1))
     for s in subset:
-        cells = [cell(success(root / f"perception-{p}" / f"{s}-sub100"), 100, 0) for p in PRESETS]
-        print(f"| `{s}` | " + " | ".join(cells) + " |")
+        runs = [root / f"perception-{p}" / f"{s}-sub100" for p in PRESETS]
+        cells = [cell(success(run), 100, 0) for run in runs]
+        print(f"| `{s}` | " + " | ".join(cells) + f" | {lost_gained(runs[0], runs[-1])} |")
     # the fast systems on the same 100 tasks, for comparison
     for s in full:
-        cells = [
-            cell(success(root / ("verti-100" if p == "none" else f"perception-{p}") / s, SUBSET), 100, 0)
-            for p in PRESETS
-        ]
-        print(f"| `{s}` | " + " | ".join(cells) + " |")
+        runs = [root / ("verti-100" if p == "none" else f"perception-{p}") / s for p in PRESETS]
+        cells = [cell(success(run, SUBSET), 100, 0) for run in runs]
+        print(f"| `{s}` | " + " | ".join(cells) + f" | {lost_gained(runs[0], runs[-1], SUBSET)} |")
 
 
 if __name__ == "__main__":
