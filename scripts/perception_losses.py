@@ -19,6 +19,8 @@ import json
 import sys
 from pathlib import Path
 
+from robustness_table import outcomes  # scripts/ is on the path when this file runs
+
 
 def results(run):
     with open(Path(run) / "results.jsonl") as f:
@@ -26,8 +28,8 @@ def results(run):
 
 
 def lost_tasks(solved_run, noisy_run):
-    a, b = results(solved_run), results(noisy_run)
-    return sorted(t for t in a if t in b and a[t]["outcome"] == "success" and b[t]["outcome"] != "success")
+    a, b = outcomes(solved_run), outcomes(noisy_run)
+    return sorted(t for t in a.keys() & b.keys() if a[t] == "success" and b[t] != "success")
 
 
 def distance_to_polyline(points, vertices):

@@ -51,6 +51,11 @@ def lost_gained(clean, noisy, tasks=None):
     return f"{lost} / {gained}"
 
 
+def full_run(root, preset, system):
+    """A fast system's run at `preset`: without noise it is the plain verti-100 run."""
+    return root / ("verti-100" if preset == "none" else f"perception-{preset}") / system
+
+
 def cell(result, expected, digits):
     if result is None:
         return "—"
@@ -70,10 +75,7 @@ def main(root):
     print("| system | " + " | ".join(PRESETS) + " |")
     print("|---|" + "---:|" * len(PRESETS))
     for s in full:
-        cells = [
-            cell(success(root / ("verti-100" if p == "none" else f"perception-{p}") / s), 1000, 1)
-            for p in PRESETS
-        ]
+        cells = [cell(success(full_run(root, p, s)), 1000, 1) for p in PRESETS]
         print(f"| `{s}` | " + " | ".join(cells) + " |")
     print()
     print("| system (100 tasks) | " + " | ".join(PRESETS) + " | lost / gained at high |")
@@ -84,7 +86,7 @@ def main(root):
         print(f"| `{s}` | " + " | ".join(cells) + f" | {lost_gained(runs[0], runs[-1])} |")
     # the fast systems on the same 100 tasks, for comparison
     for s in full:
-        runs = [root / ("verti-100" if p == "none" else f"perception-{p}") / s for p in PRESETS]
+        runs = [full_run(root, p, s) for p in PRESETS]
         cells = [cell(success(run, SUBSET), 100, 0) for run in runs]
         print(f"| `{s}` | " + " | ".join(cells) + f" | {lost_gained(runs[0], runs[-1], SUBSET)} |")
 
