@@ -8,6 +8,7 @@
 //! * [`lsq`]: least-squares coefficients (batched normal equations, Cholesky) and recursive
 //!   least squares with forgetting;
 //! * [`model`]: the model card (VertiAdaptor and its baselines) and its evaluation;
+//!   `fields` lays the basis fields out for the planner's rollouts (bit-identical, faster);
 //! * [`data`]: trajectories of a dataset with their terrain latents, split by world.
 
 use std::path::PathBuf;
@@ -16,6 +17,7 @@ pub mod adapter;
 pub mod data;
 pub mod eval;
 pub mod explore;
+mod fields;
 pub mod lsq;
 pub mod model;
 pub mod planner;

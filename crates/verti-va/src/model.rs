@@ -21,6 +21,7 @@
 //! [inputs][outputs], then biases), then the fields' layers stacked over the k fields
 //! (weights [k][inputs][outputs], then biases [k][outputs]).
 
+use crate::fields::{FieldKernel, StackedRef};
 use crate::lsq::{EXAMPLE_BATCH, NormalEquations};
 use crate::rk4::rk4_delta;
 use crate::terrain::{ELEVATION_LATENT, SEMANTIC_LATENT, TERRAIN_DIM};
@@ -209,6 +210,8 @@ pub struct VaModel {
     elevation: Vec<Stacked>,
     semantics: Vec<Stacked>,
     fields: Vec<Stacked>,
+    /// The fields in the fast layout (bit-identical to the plain loops below).
+    kernel: Option<FieldKernel>,
 }
 
 /// One example for adaptation or evaluation: the model's inputs and the true change.
@@ -291,11 +294,22 @@ impl VaModel {
         let elevation = take_layers(params, &mut at, &embed_sizes(ELEVATION_LATENT), 1);
         let semantics = take_layers(params, &mut at, &embed_sizes(SEMANTIC_LATENT), 1);
         let fields = take_layers(params, &mut at, &card.field_sizes(), card.bases);
+        let stacked: Vec<StackedRef> = fields
+            .iter()
+            .map(|l| StackedRef {
+                inputs: l.inputs,
+                outputs: l.outputs,
+                w: &l.w,
+                b: &l.b,
+            })
+            .collect();
+        let kernel = FieldKernel::new(card.bases, &stacked);
         Ok(VaModel {
             card,
             elevation,
             semantics,
             fields,
+            kernel,
         })
     }
 
@@ -466,7 +480,8 @@ impl VaModel {
     }
 
     /// Every basis function's change G_i over one step, k × 6 row-major into `out`: RK4 of
-    /// the field for `va` and `node`, the network's output for `mlp` and `maml`.
+    /// the field for `va` and `node`, the network's output for `mlp` and `maml`. Computed by
+    /// the fast field kernel, bit-identical to [`VaModel::basis_changes_reference`].
     pub fn basis_changes(
         &self,
         roll: f64,
@@ -475,10 +490,31 @@ impl VaModel {
         command: (f64, f64),
         out: &mut [f64],
     ) {
-        let mut rest = [0f32; FIELD_INPUT - 2];
-        rest[..2 * EMBED].copy_from_slice(embedding);
-        rest[2 * EMBED] = command.0 as f32;
-        rest[2 * EMBED + 1] = command.1 as f32;
+        let Some(kernel) = &self.kernel else {
+            return self.basis_changes_reference(roll, pitch, embedding, command, out);
+        };
+        let rest = held_inputs(embedding, command);
+        let integrates = self.card.method.integrates();
+        kernel.basis_changes(integrates, self.card.dt, roll, pitch, &rest, out);
+    }
+
+    /// The fast kernel, if this card's fields fit it.
+    #[cfg(test)]
+    pub(crate) fn kernel(&self) -> Option<&FieldKernel> {
+        self.kernel.as_ref()
+    }
+
+    /// [`VaModel::basis_changes`] by plain loops over the stacked weights: the definition the
+    /// fast kernel is tested against (and the path for fields wider than it takes).
+    pub fn basis_changes_reference(
+        &self,
+        roll: f64,
+        pitch: f64,
+        embedding: &[f32; 2 * EMBED],
+        command: (f64, f64),
+        out: &mut [f64],
+    ) {
+        let rest = held_inputs(embedding, command);
         let width = self
             .card
             .hidden
@@ -556,6 +592,19 @@ impl VaModel {
             .solve(self.card.lambda)
             .map_err(|e| VaError::Data(format!("{}: {e}", self.card.name)))
     }
+}
+
+/// A field's inputs other than roll and pitch: the embeddings and the command, held through
+/// the RK4 stages.
+pub(crate) fn held_inputs(
+    embedding: &[f32; 2 * EMBED],
+    command: (f64, f64),
+) -> [f32; FIELD_INPUT - 2] {
+    let mut rest = [0f32; FIELD_INPUT - 2];
+    rest[..2 * EMBED].copy_from_slice(embedding);
+    rest[2 * EMBED] = command.0 as f32;
+    rest[2 * EMBED + 1] = command.1 as f32;
+    rest
 }
 
 /// Parses a card, naming the file and the problem.
