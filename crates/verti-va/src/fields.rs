@@ -4,11 +4,13 @@
 //! [`FieldKernel`] computes exactly what the plain loops of [`crate::model`] compute, bit for
 //! bit: every output is its bias plus its inputs' products in the same order, and multiplies
 //! and adds stay separate (Rust never fuses them). What changes is the layout and the
-//! control flow: each field's weights are stored in blocks of eight outputs, up to four blocks
-//! are summed at once with their sums held in registers across the whole loop over inputs
-//! (instead of loading and storing every output once per input), and zero inputs are not
-//! branched around (see [`dense_group`] for why that keeps the bits). Where the
-//! CPU has AVX the same code is compiled for 256-bit registers.
+//! control flow: each field's weights are stored in blocks of eight outputs; two fields go
+//! through their layers together, up to four blocks of each at once, with the sums held in
+//! registers across the whole loop over inputs (instead of loading and storing every output
+//! once per input; two fields, because one field's one-block output layer alone is a single
+//! chain of dependent adds); and zero inputs are not branched around (see
+//! [`dense_group_pair`] for why that keeps the bits). Where the CPU has AVX the same code is
+//! compiled for 256-bit registers.
 
 use crate::model::{FIELD_INPUT, POSE_DIM};
 
@@ -97,8 +99,9 @@ fn avx_available() -> bool {
     }
 }
 
-/// Up to `G` blocks of one layer from inputs `x`: `w` is G × [inputs][BLOCK], `b` and `y`
-/// G × BLOCK.
+/// Up to `G` blocks of one layer for two fields of the same shape at once (twice the
+/// independent sums, which hides the adds' latency): inputs `x1`, `x2`; `w` is G × [inputs]
+/// [BLOCK], `b` and `y` G × BLOCK.
 ///
 /// The plain loops skip zero inputs; this kernel adds their products, because a branch per
 /// input mispredicts on ReLU's random zeros and costs more than the arithmetic. The bits are
@@ -107,50 +110,127 @@ fn avx_available() -> bool {
 /// anywhere else, adds give a nonzero value or +0 (exact cancellation rounds to +0) — and
 /// [`FieldKernel::new`] refuses such biases.
 #[inline(always)]
-fn dense_group<const G: usize>(x: &[f32], w: &[f32], b: &[f32], y: &mut [f32]) {
-    let inputs = x.len();
-    let mut acc = [[0.0f32; BLOCK]; G];
-    for (g, a) in acc.iter_mut().enumerate() {
-        a.copy_from_slice(&b[g * BLOCK..(g + 1) * BLOCK]);
+#[allow(clippy::too_many_arguments)]
+fn dense_group_pair<const G: usize>(
+    x1: &[f32],
+    x2: &[f32],
+    w1: &[f32],
+    w2: &[f32],
+    b1: &[f32],
+    b2: &[f32],
+    y1: &mut [f32],
+    y2: &mut [f32],
+) {
+    let inputs = x1.len();
+    let mut acc1 = [[0.0f32; BLOCK]; G];
+    let mut acc2 = [[0.0f32; BLOCK]; G];
+    for g in 0..G {
+        acc1[g].copy_from_slice(&b1[g * BLOCK..(g + 1) * BLOCK]);
+        acc2[g].copy_from_slice(&b2[g * BLOCK..(g + 1) * BLOCK]);
     }
-    for (i, &xi) in x.iter().enumerate() {
-        for (g, a) in acc.iter_mut().enumerate() {
-            let wi = &w[(g * inputs + i) * BLOCK..(g * inputs + i + 1) * BLOCK];
+    for i in 0..inputs {
+        let (u, v) = (x1[i], x2[i]);
+        for g in 0..G {
+            let wa = &w1[(g * inputs + i) * BLOCK..(g * inputs + i + 1) * BLOCK];
+            let wb = &w2[(g * inputs + i) * BLOCK..(g * inputs + i + 1) * BLOCK];
             for j in 0..BLOCK {
-                a[j] += xi * wi[j];
+                acc1[g][j] += u * wa[j];
+                acc2[g][j] += v * wb[j];
             }
         }
     }
-    for (a, y) in acc.iter().zip(y.chunks_exact_mut(BLOCK)) {
-        y.copy_from_slice(a);
+    for g in 0..G {
+        y1[g * BLOCK..(g + 1) * BLOCK].copy_from_slice(&acc1[g]);
+        y2[g * BLOCK..(g + 1) * BLOCK].copy_from_slice(&acc2[g]);
     }
 }
 
-/// All outputs of `layer` from `x` into `y` (`layer.padded()` values).
+/// All outputs of one layer of two fields (`l1.padded()` values each).
 #[inline(always)]
-fn dense_layer(layer: &Blocked, x: &[f32], y: &mut [f32]) {
-    let col = layer.inputs * BLOCK;
-    let blocks = layer.padded() / BLOCK;
+fn dense_layer_pair(
+    l1: &Blocked,
+    l2: &Blocked,
+    x1: &[f32],
+    x2: &[f32],
+    y1: &mut [f32],
+    y2: &mut [f32],
+) {
+    let col = l1.inputs * BLOCK;
+    let blocks = l1.padded() / BLOCK;
     let mut first = 0;
     while first < blocks {
         let g = (blocks - first).min(GROUP);
-        let w = &layer.weights[first * col..(first + g) * col];
-        let b = &layer.bias[first * BLOCK..(first + g) * BLOCK];
-        let y = &mut y[first * BLOCK..(first + g) * BLOCK];
+        let (w1, w2) = (
+            &l1.weights[first * col..(first + g) * col],
+            &l2.weights[first * col..(first + g) * col],
+        );
+        let (b1, b2) = (
+            &l1.bias[first * BLOCK..(first + g) * BLOCK],
+            &l2.bias[first * BLOCK..(first + g) * BLOCK],
+        );
+        let (y1, y2) = (
+            &mut y1[first * BLOCK..(first + g) * BLOCK],
+            &mut y2[first * BLOCK..(first + g) * BLOCK],
+        );
         match g {
-            4 => dense_group::<4>(x, w, b, y),
-            3 => dense_group::<3>(x, w, b, y),
-            2 => dense_group::<2>(x, w, b, y),
-            _ => dense_group::<1>(x, w, b, y),
+            4 => dense_group_pair::<4>(x1, x2, w1, w2, b1, b2, y1, y2),
+            3 => dense_group_pair::<3>(x1, x2, w1, w2, b1, b2, y1, y2),
+            2 => dense_group_pair::<2>(x1, x2, w1, w2, b1, b2, y1, y2),
+            _ => dense_group_pair::<1>(x1, x2, w1, w2, b1, b2, y1, y2),
         }
         first += g;
     }
 }
 
+/// The first layer's sums at attitude (r, p) from their held part `base`: base + r·w_roll +
+/// p·w_pitch, in that order.
+#[inline(always)]
+fn first_layer(field: &Field, base: &[f32], r: f32, p: f32, a: &mut [f32; MAX_WIDTH]) {
+    for (((a, c), wr), wp) in a.iter_mut().zip(base).zip(&field.roll).zip(&field.pitch) {
+        *a = c + r * wr + p * wp;
+    }
+}
+
+/// Two fields of the same shape, each at its attitude (roll, pitch), from their first layers' held
+/// parts `base`: the pose rates of each.
+#[inline(always)]
+fn stage_pair(
+    fields: [&Field; 2],
+    base: [&[f32]; 2],
+    at: [(f64, f64); 2],
+    a: &mut [[f32; MAX_WIDTH]; 2],
+    b: &mut [[f32; MAX_WIDTH]; 2],
+) -> [[f64; POSE_DIM]; 2] {
+    for f in 0..2 {
+        let (r, p) = (at[f].0 as f32, at[f].1 as f32);
+        first_layer(fields[f], base[f], r, p, &mut a[f]);
+    }
+    let (mut cur, mut next) = (a, b);
+    for (l1, l2) in fields[0].layers.iter().zip(&fields[1].layers) {
+        for x in cur.iter_mut() {
+            for v in x[..l1.inputs].iter_mut() {
+                *v = v.max(0.0);
+            }
+        }
+        let [x1, x2] = &*cur;
+        let [y1, y2] = &mut *next;
+        dense_layer_pair(
+            l1,
+            l2,
+            &x1[..l1.inputs],
+            &x2[..l1.inputs],
+            &mut y1[..l1.padded()],
+            &mut y2[..l1.padded()],
+        );
+        std::mem::swap(&mut cur, &mut next);
+    }
+    [0, 1].map(|f| std::array::from_fn(|d| f64::from(cur[f][d])))
+}
+
 impl FieldKernel {
     /// The kernel for `k` fields stacked as `layers` (the first takes [`FIELD_INPUT`] inputs,
     /// the last gives [`POSE_DIM`] outputs); `None` when a layer is wider than [`MAX_WIDTH`]
-    /// or a bias is −0 (see [`dense_group`]; weights are finite, as model cards are checked).
+    /// or a bias is −0 (see [`dense_group_pair`]; weights are finite, as model cards are checked).
     pub(crate) fn new<'a>(k: usize, layers: &[StackedRef<'a>]) -> Option<FieldKernel> {
         let (first, rest) = layers.split_first()?;
         if first.inputs != FIELD_INPUT
@@ -255,58 +335,49 @@ impl FieldKernel {
         rest: &[f32; REST],
         out: &mut [f64],
     ) {
-        let mut base = [0.0f32; MAX_WIDTH];
-        let mut a = [0.0f32; MAX_WIDTH];
-        let mut b = [0.0f32; MAX_WIDTH];
-        for (i, field) in self.fields.iter().enumerate() {
-            let width = field.rest.padded();
+        let mut base = [[0.0f32; MAX_WIDTH]; 2];
+        let mut a = [[0.0f32; MAX_WIDTH]; 2];
+        let mut b = [[0.0f32; MAX_WIDTH]; 2];
+        // two fields at a time; an odd last field is paired with itself (the baselines'
+        // single field pays twice, VertiAdaptor's 24 never)
+        for first in (0..self.fields.len()).step_by(2) {
+            let second = (first + 1).min(self.fields.len() - 1);
+            let fields = [&self.fields[first], &self.fields[second]];
+            let width = fields[0].rest.padded();
             // the held inputs' part of the first layer, once per step instead of per stage
-            dense_layer(&field.rest, rest, &mut base[..width]);
-            let base = &base[..width];
+            let [b0, b1] = &mut base;
+            dense_layer_pair(
+                &fields[0].rest,
+                &fields[1].rest,
+                rest,
+                rest,
+                &mut b0[..width],
+                &mut b1[..width],
+            );
+            let bases = [&b0[..width], &b1[..width]];
             let g = if integrates {
-                // crate::rk4::rk4_delta written out: a closure would be compiled without
-                // this function's AVX target; only roll and pitch move the field's input
-                let shifted = |k: &[f64; POSE_DIM], h: f64| (roll + h * k[4], pitch + h * k[5]);
-                let k1 = stage(field, base, roll, pitch, &mut a, &mut b);
-                let (r, p) = shifted(&k1, 0.5 * dt);
-                let k2 = stage(field, base, r, p, &mut a, &mut b);
-                let (r, p) = shifted(&k2, 0.5 * dt);
-                let k3 = stage(field, base, r, p, &mut a, &mut b);
-                let (r, p) = shifted(&k3, dt);
-                let k4 = stage(field, base, r, p, &mut a, &mut b);
-                std::array::from_fn(|d| dt / 6.0 * (k1[d] + 2.0 * k2[d] + 2.0 * k3[d] + k4[d]))
+                // crate::rk4::rk4_delta written out for the pair (a closure would be compiled
+                // without this function's AVX target); only roll and pitch move the input
+                let shifted = |k: &[[f64; POSE_DIM]; 2], h: f64| {
+                    [0, 1].map(|f| (roll + h * k[f][4], pitch + h * k[f][5]))
+                };
+                let k1 = stage_pair(fields, bases, [(roll, pitch); 2], &mut a, &mut b);
+                let k2 = stage_pair(fields, bases, shifted(&k1, 0.5 * dt), &mut a, &mut b);
+                let k3 = stage_pair(fields, bases, shifted(&k2, 0.5 * dt), &mut a, &mut b);
+                let k4 = stage_pair(fields, bases, shifted(&k3, dt), &mut a, &mut b);
+                [0, 1].map(|f| {
+                    std::array::from_fn(|d| {
+                        dt / 6.0 * (k1[f][d] + 2.0 * k2[f][d] + 2.0 * k3[f][d] + k4[f][d])
+                    })
+                })
             } else {
-                stage(field, base, roll, pitch, &mut a, &mut b)
+                stage_pair(fields, bases, [(roll, pitch); 2], &mut a, &mut b)
             };
-            out[i * POSE_DIM..(i + 1) * POSE_DIM].copy_from_slice(&g);
+            for (i, g) in [first, second].into_iter().zip(&g) {
+                out[i * POSE_DIM..(i + 1) * POSE_DIM].copy_from_slice(g);
+            }
         }
     }
-}
-
-/// One field at attitude (roll, pitch) from its first layer's held part `base`.
-#[inline(always)]
-fn stage(
-    field: &Field,
-    base: &[f32],
-    roll: f64,
-    pitch: f64,
-    a: &mut [f32; MAX_WIDTH],
-    b: &mut [f32; MAX_WIDTH],
-) -> [f64; POSE_DIM] {
-    let (r, p) = (roll as f32, pitch as f32);
-    for o in 0..base.len() {
-        a[o] = base[o] + r * field.roll[o] + p * field.pitch[o];
-    }
-    let (mut cur, mut next) = (a, b);
-    for layer in &field.layers {
-        // the previous layer was hidden: ReLU
-        for v in cur[..layer.inputs].iter_mut() {
-            *v = v.max(0.0);
-        }
-        dense_layer(layer, &cur[..layer.inputs], &mut next[..layer.padded()]);
-        std::mem::swap(&mut cur, &mut next);
-    }
-    std::array::from_fn(|d| f64::from(cur[d]))
 }
 
 #[cfg(test)]
