@@ -39,6 +39,8 @@ pub struct StepScratch {
     mlp: MlpScratch,
     /// An attentive model's map, set by [`KinoModel::begin`].
     map: MapContext,
+    /// What the networks predicted this step (the first `network_outputs` values).
+    result: [f64; OUTPUT_DIM],
 }
 
 /// A loaded model, cheap to clone (the file is shared).
@@ -82,6 +84,7 @@ impl KinoModel {
                 KinoKind::Attentive => self.file.mlps[0].outputs(),
                 _ => 0,
             }),
+            result: [0.0; OUTPUT_DIM],
         }
     }
 
@@ -103,45 +106,126 @@ impl KinoModel {
         m.reference = Some(*reference);
     }
 
-    /// An attentive model's change over one step (full-scale units), from the map features
-    /// gated by the offset and the head.
-    fn attentive_delta(
+    /// Step phase 1: the networks' inputs for `state` under `command`, into `scratch`; returns
+    /// the sine and cosine of the heading. (An attentive model's gate needs its network's
+    /// output first: phase 2 finishes that input.)
+    fn write_step_inputs(
         &self,
         state: &KinoState,
         command: (f64, f64),
+        terrain: &Heightfield,
         units: Units,
         scratch: &mut StepScratch,
-    ) -> [f64; OUTPUT_DIM] {
-        let f = &*self.file;
-        let m = &mut scratch.map;
-        let reference = m
-            .reference
-            .expect("KinoModel::begin runs before an attentive model steps");
-        write_offset(&reference, &state.pose, units, &mut m.offset);
-        f.mlps[1].forward_into(&m.offset, &mut scratch.mlp, &mut m.gate);
-        let n = m.features.len();
-        for ((x, e), g) in m.dynamics_in[..n].iter_mut().zip(&m.features).zip(&m.gate) {
-            *x = e * squash(*g);
-        }
-        write_head(state, command, units, f.card.dt, &mut m.dynamics_in[n..]);
-        f.mlps[2].forward_into(&m.dynamics_in, &mut scratch.mlp, &mut m.out);
-        m.out.map(f64::from)
-    }
-
-    /// The networks' mean prediction for the raw inputs in `scratch.input`, into `out` (the
-    /// standardisation is folded into the networks).
-    fn predict(&self, scratch: &mut StepScratch, out: &mut [f64]) {
-        let f = &*self.file;
-        scratch.sum.iter_mut().for_each(|v| *v = 0.0);
-        for mlp in &f.mlps {
-            mlp.forward_into(&scratch.input, &mut scratch.mlp, &mut scratch.out);
-            for (s, o) in scratch.sum.iter_mut().zip(&scratch.out) {
-                *s += o;
+    ) -> (f64, f64) {
+        let dt = self.dt();
+        match self.file.card.kind {
+            KinoKind::Ensemble | KinoKind::Decomposed => {
+                write_inputs(state, command, terrain, units, dt, &mut scratch.input)
+            }
+            KinoKind::Attentive => {
+                let m = &mut scratch.map;
+                let reference = m
+                    .reference
+                    .expect("KinoModel::begin runs before an attentive model steps");
+                write_offset(&reference, &state.pose, units, &mut m.offset);
+                let n = m.features.len();
+                write_head(state, command, units, dt, &mut m.dynamics_in[n..]);
+                state.pose.yaw.sin_cos()
             }
         }
-        let inv = 1.0 / f.mlps.len() as f64;
-        for (o, s) in out.iter_mut().zip(&scratch.sum) {
-            *o = *s as f64 * inv;
+    }
+
+    /// Step phase 2: the networks on the inputs of phase 1, into `scratch.result` — an
+    /// ensemble's mean, or an attentive model's gated dynamics.
+    fn run_networks(&self, scratch: &mut StepScratch) {
+        let f = &*self.file;
+        match f.card.kind {
+            KinoKind::Ensemble | KinoKind::Decomposed => {
+                scratch.sum.iter_mut().for_each(|v| *v = 0.0);
+                for mlp in &f.mlps {
+                    mlp.forward_into(&scratch.input, &mut scratch.mlp, &mut scratch.out);
+                    accumulate(&mut scratch.sum, &scratch.out);
+                }
+                mean_into(&scratch.sum, f.mlps.len(), &mut scratch.result);
+            }
+            KinoKind::Attentive => {
+                let m = &mut scratch.map;
+                f.mlps[1].forward_into(&m.offset, &mut scratch.mlp, &mut m.gate);
+                gate_features(m);
+                f.mlps[2].forward_into(&m.dynamics_in, &mut scratch.mlp, &mut m.out);
+                scratch.result = m.out.map(f64::from);
+            }
+        }
+    }
+
+    /// [`KinoModel::run_networks`] for two samples at once (bit for bit the same): each
+    /// network evaluates both inputs side by side, hiding its adds' latency.
+    fn run_networks_pair(&self, s: [&mut StepScratch; 2]) {
+        let f = &*self.file;
+        let [a, b] = s;
+        match f.card.kind {
+            KinoKind::Ensemble | KinoKind::Decomposed => {
+                a.sum.iter_mut().for_each(|v| *v = 0.0);
+                b.sum.iter_mut().for_each(|v| *v = 0.0);
+                for mlp in &f.mlps {
+                    mlp.forward_pair_into(
+                        [&a.input, &b.input],
+                        [&mut a.mlp, &mut b.mlp],
+                        [&mut a.out, &mut b.out],
+                    );
+                    accumulate(&mut a.sum, &a.out);
+                    accumulate(&mut b.sum, &b.out);
+                }
+                mean_into(&a.sum, f.mlps.len(), &mut a.result);
+                mean_into(&b.sum, f.mlps.len(), &mut b.result);
+            }
+            KinoKind::Attentive => {
+                let (ma, mb) = (&mut a.map, &mut b.map);
+                f.mlps[1].forward_pair_into(
+                    [&ma.offset, &mb.offset],
+                    [&mut a.mlp, &mut b.mlp],
+                    [&mut ma.gate, &mut mb.gate],
+                );
+                gate_features(ma);
+                gate_features(mb);
+                f.mlps[2].forward_pair_into(
+                    [&ma.dynamics_in, &mb.dynamics_in],
+                    [&mut a.mlp, &mut b.mlp],
+                    [&mut ma.out, &mut mb.out],
+                );
+                a.result = ma.out.map(f64::from);
+                b.result = mb.out.map(f64::from);
+            }
+        }
+    }
+
+    /// Step phase 3: the next state from the networks' `result` (world units).
+    #[allow(clippy::too_many_arguments)]
+    fn finish_step(
+        &self,
+        state: &KinoState,
+        command: (f64, f64),
+        terrain: &Heightfield,
+        units: Units,
+        geometry: Geometry,
+        sc: (f64, f64),
+        result: &[f64; OUTPUT_DIM],
+    ) -> KinoState {
+        let pose = &state.pose;
+        let delta = match self.file.card.kind {
+            KinoKind::Ensemble | KinoKind::Attentive => units.delta_to_world(result),
+            KinoKind::Decomposed => {
+                let dt_world = self.dt() / units.time_factor();
+                let mut d = bicycle_on_ground(pose, command, terrain, geometry, dt_world, sc);
+                // the network predicts the next attitude itself
+                d[4] = result[0] - pose.roll;
+                d[5] = result[1] - pose.pitch;
+                d
+            }
+        };
+        KinoState {
+            pose: apply_delta_sc(pose, &delta, sc),
+            last_delta: delta,
         }
     }
 
@@ -157,35 +241,72 @@ impl KinoModel {
         geometry: Geometry,
         scratch: &mut StepScratch,
     ) -> KinoState {
-        let dt = self.dt();
-        let pose = &state.pose;
-        let (delta, sc) = match self.file.card.kind {
-            KinoKind::Ensemble => {
-                let sc = write_inputs(state, command, terrain, units, dt, &mut scratch.input);
-                let mut d = [0.0; OUTPUT_DIM];
-                self.predict(scratch, &mut d);
-                (units.delta_to_world(&d), sc)
-            }
-            KinoKind::Decomposed => {
-                let sc = write_inputs(state, command, terrain, units, dt, &mut scratch.input);
-                let mut rp = [0.0; 2];
-                self.predict(scratch, &mut rp);
-                let dt_world = dt / units.time_factor();
-                let mut d = bicycle_on_ground(pose, command, terrain, geometry, dt_world, sc);
-                // the network predicts the next attitude itself
-                d[4] = rp[0] - pose.roll;
-                d[5] = rp[1] - pose.pitch;
-                (d, sc)
-            }
-            KinoKind::Attentive => {
-                let d = self.attentive_delta(state, command, units, scratch);
-                (units.delta_to_world(&d), pose.yaw.sin_cos())
-            }
-        };
-        KinoState {
-            pose: apply_delta_sc(pose, &delta, sc),
-            last_delta: delta,
-        }
+        let sc = self.write_step_inputs(state, command, terrain, units, scratch);
+        self.run_networks(scratch);
+        let result = scratch.result;
+        self.finish_step(state, command, terrain, units, geometry, sc, &result)
+    }
+
+    /// Two states one step later, bit for bit what two [`KinoModel::step`] calls give, with
+    /// the networks evaluated as a pair (each scratch must have seen the same `begin`).
+    pub fn step_pair(
+        &self,
+        states: [&KinoState; 2],
+        commands: [(f64, f64); 2],
+        terrain: &Heightfield,
+        units: Units,
+        geometry: Geometry,
+        scratch: &mut [StepScratch; 2],
+    ) -> [KinoState; 2] {
+        let [a, b] = scratch;
+        let sc = [
+            self.write_step_inputs(states[0], commands[0], terrain, units, a),
+            self.write_step_inputs(states[1], commands[1], terrain, units, b),
+        ];
+        self.run_networks_pair([&mut *a, &mut *b]);
+        [
+            self.finish_step(
+                states[0],
+                commands[0],
+                terrain,
+                units,
+                geometry,
+                sc[0],
+                &a.result,
+            ),
+            self.finish_step(
+                states[1],
+                commands[1],
+                terrain,
+                units,
+                geometry,
+                sc[1],
+                &b.result,
+            ),
+        ]
+    }
+}
+
+/// sum += out, in f32 as the ensemble has always summed.
+fn accumulate(sum: &mut [f32], out: &[f32]) {
+    for (s, o) in sum.iter_mut().zip(out) {
+        *s += o;
+    }
+}
+
+/// The ensemble mean: each f32 sum in f64 times 1/members.
+fn mean_into(sum: &[f32], members: usize, out: &mut [f64; OUTPUT_DIM]) {
+    let inv = 1.0 / members as f64;
+    for (o, s) in out.iter_mut().zip(sum) {
+        *o = *s as f64 * inv;
+    }
+}
+
+/// An attentive model's dynamics input: the map features gated by the gate network's output.
+fn gate_features(m: &mut MapContext) {
+    let n = m.features.len();
+    for ((x, e), g) in m.dynamics_in[..n].iter_mut().zip(&m.features).zip(&m.gate) {
+        *x = e * squash(*g);
     }
 }
 

@@ -16,7 +16,8 @@ use verti_world::Heightfield;
 /// (`dt`·√s world seconds), whatever MPPI's `step` says.
 pub struct LearnedRollout {
     model: KinoModel,
-    scratch: StepScratch,
+    /// One per sample of a pair (samples are rolled out two at a time).
+    scratch: [StepScratch; 2],
     units: Units,
     geometry: Geometry,
     /// The trial's ground, copied at its first plan (a 129 x 129 grid: ~130 kB).
@@ -30,7 +31,7 @@ pub struct LearnedRollout {
 impl LearnedRollout {
     pub fn new(model: KinoModel) -> LearnedRollout {
         LearnedRollout {
-            scratch: model.scratch(),
+            scratch: [model.scratch(), model.scratch()],
             model,
             units: Units::new(1.0),
             geometry: Geometry::default(),
@@ -86,19 +87,43 @@ impl RolloutModel for LearnedRollout {
             .as_ref()
             .expect("LearnedRollout::prepare runs before rollout");
         let h = controls.horizon;
-        self.model
-            .begin(&self.start.pose, terrain, self.units, &mut self.scratch);
-        for s in 0..controls.samples {
-            let mut state = self.start;
-            let u = &controls.controls[s * h..(s + 1) * h];
-            for (t, &command) in u.iter().enumerate() {
-                state = self.model.step(
-                    &state,
-                    command,
+        for scratch in &mut self.scratch {
+            self.model
+                .begin(&self.start.pose, terrain, self.units, scratch);
+        }
+        // samples two at a time: their networks run side by side (bit for bit what one at a
+        // time gives; an odd last sample steps alone)
+        let n = controls.samples;
+        for s in (0..n - n % 2).step_by(2) {
+            let mut states = [self.start; 2];
+            for t in 0..h {
+                let commands = [
+                    controls.controls[s * h + t],
+                    controls.controls[(s + 1) * h + t],
+                ];
+                states = self.model.step_pair(
+                    [&states[0], &states[1]],
+                    commands,
                     terrain,
                     self.units,
                     self.geometry,
                     &mut self.scratch,
+                );
+                out.poses[s * h + t] = states[0].pose;
+                out.poses[(s + 1) * h + t] = states[1].pose;
+            }
+        }
+        if n % 2 == 1 {
+            let s = n - 1;
+            let mut state = self.start;
+            for t in 0..h {
+                state = self.model.step(
+                    &state,
+                    controls.controls[s * h + t],
+                    terrain,
+                    self.units,
+                    self.geometry,
+                    &mut self.scratch[0],
                 );
                 out.poses[s * h + t] = state.pose;
             }

@@ -146,6 +146,33 @@ fn rollouts_have_the_samples_shape_and_repeat_exactly() {
         assert_eq!(runs[0], runs[1], "{}", file.card.name);
         // different controls, different futures
         assert_ne!(runs[0][horizon - 1], runs[0][2 * horizon - 1]);
+        // samples are rolled out in pairs (7: three pairs and one alone); each must be what
+        // rolling it out on its own (one sample: no pair) gives, bit for bit
+        let bits = |p: &Pose6| [p.x, p.y, p.z, p.roll, p.pitch, p.yaw].map(f64::to_bits);
+        for s in 0..samples {
+            let mine = &controls.controls[s * horizon..(s + 1) * horizon];
+            let one = ControlSamples {
+                samples: 1,
+                horizon,
+                controls: mine,
+                nominal: &nominal,
+                noise: mine,
+            };
+            let mut r = LearnedRollout::new(KinoModel::new(file.clone()));
+            r.reset(&info);
+            r.prepare(&obs, &ctx);
+            let mut out = Rollouts::default();
+            out.resize(1, horizon);
+            r.rollout(&ctx, &one, &mut out);
+            for t in 0..horizon {
+                assert_eq!(
+                    bits(&out.poses[t]),
+                    bits(&runs[0][s * horizon + t]),
+                    "{} sample {s} step {t}",
+                    file.card.name
+                );
+            }
+        }
     }
 }
 

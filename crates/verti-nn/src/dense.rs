@@ -96,17 +96,63 @@ fn dense_group<const G: usize>(
         }
     }
     for (a, y) in acc.iter_mut().zip(y.chunks_exact_mut(BLOCK)) {
-        match activation {
-            Activation::Identity => {}
-            Activation::Relu => a.iter_mut().for_each(|v| *v = v.max(0.0)),
-            Activation::LeakyRelu(s) => a.iter_mut().for_each(|v| {
-                if *v < 0.0 {
-                    *v *= s
-                }
-            }),
-            Activation::Tanh => a.iter_mut().for_each(|v| *v = libm::tanhf(*v)),
-        }
+        activate(a, activation);
         y.copy_from_slice(a);
+    }
+}
+
+/// [`dense_group`] for two inputs through the same blocks at once: twice the independent sums
+/// (one block alone, an output layer, is a single chain of dependent adds), each output's sum
+/// unchanged. Separate arrays of sums for the two, so that they stay in registers.
+#[inline(always)]
+fn dense_group_pair<const G: usize>(
+    x1: &[f32],
+    x2: &[f32],
+    w: &[f32],
+    b: &[f32],
+    activation: Activation,
+    y1: &mut [f32],
+    y2: &mut [f32],
+) {
+    let inputs = x1.len();
+    let x2 = &x2[..inputs];
+    let mut acc1 = [[0.0f32; BLOCK]; G];
+    let mut acc2 = [[0.0f32; BLOCK]; G];
+    for g in 0..G {
+        acc1[g].copy_from_slice(&b[g * BLOCK..(g + 1) * BLOCK]);
+        acc2[g].copy_from_slice(&b[g * BLOCK..(g + 1) * BLOCK]);
+    }
+    for i in 0..inputs {
+        let (u, v) = (x1[i], x2[i]);
+        for g in 0..G {
+            let wi = &w[(g * inputs + i) * BLOCK..(g * inputs + i + 1) * BLOCK];
+            for j in 0..BLOCK {
+                acc1[g][j] += u * wi[j];
+                acc2[g][j] += v * wi[j];
+            }
+        }
+    }
+    for (a, y) in acc1.iter_mut().zip(y1.chunks_exact_mut(BLOCK)) {
+        activate(a, activation);
+        y.copy_from_slice(a);
+    }
+    for (a, y) in acc2.iter_mut().zip(y2.chunks_exact_mut(BLOCK)) {
+        activate(a, activation);
+        y.copy_from_slice(a);
+    }
+}
+
+#[inline(always)]
+fn activate(a: &mut [f32; BLOCK], activation: Activation) {
+    match activation {
+        Activation::Identity => {}
+        Activation::Relu => a.iter_mut().for_each(|v| *v = v.max(0.0)),
+        Activation::LeakyRelu(s) => a.iter_mut().for_each(|v| {
+            if *v < 0.0 {
+                *v *= s
+            }
+        }),
+        Activation::Tanh => a.iter_mut().for_each(|v| *v = libm::tanhf(*v)),
     }
 }
 
@@ -349,6 +395,90 @@ impl Mlp {
             std::mem::swap(&mut cur, &mut next);
         }
         out.copy_from_slice(&cur[..out.len()]);
+    }
+
+    /// Evaluates two inputs at once into `out` (bit for bit what two [`Mlp::forward_into`]
+    /// calls give): the sums of both run side by side, which hides the adds' latency where a
+    /// layer has few output blocks. `scratch` holds one pair of buffers per input.
+    pub fn forward_pair_into(
+        &self,
+        input: [&[f32]; 2],
+        scratch: [&mut MlpScratch; 2],
+        out: [&mut [f32]; 2],
+    ) {
+        for (x, o) in input.iter().zip(&out) {
+            assert_eq!(x.len(), self.inputs(), "MLP input length");
+            assert_eq!(o.len(), self.outputs(), "MLP output length");
+        }
+        let [s1, s2] = scratch;
+        for s in [&mut *s1, &mut *s2] {
+            if s.a.len() < self.widest {
+                *s = self.scratch();
+            }
+        }
+        let scratch = [s1, s2];
+        #[cfg(target_arch = "x86_64")]
+        if self.avx {
+            // SAFETY: `avx` is set only where the CPU reported AVX at construction.
+            unsafe { self.forward_pair_avx(input, scratch, out) };
+            return;
+        }
+        self.forward_pair_body(input, scratch, out);
+    }
+
+    /// [`Mlp::forward_pair_into`] compiled for 256-bit registers (bit-identical, as
+    /// [`Mlp::forward_avx`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn forward_pair_avx(
+        &self,
+        input: [&[f32]; 2],
+        scratch: [&mut MlpScratch; 2],
+        out: [&mut [f32]; 2],
+    ) {
+        self.forward_pair_body(input, scratch, out);
+    }
+
+    #[inline(always)]
+    fn forward_pair_body(
+        &self,
+        input: [&[f32]; 2],
+        scratch: [&mut MlpScratch; 2],
+        out: [&mut [f32]; 2],
+    ) {
+        let [s1, s2] = scratch;
+        let (mut cur1, mut next1) = (&mut s1.a, &mut s1.b);
+        let (mut cur2, mut next2) = (&mut s2.a, &mut s2.b);
+        cur1[..input[0].len()].copy_from_slice(input[0]);
+        cur2[..input[1].len()].copy_from_slice(input[1]);
+        for layer in &self.blocked {
+            let n = layer.inputs;
+            let col = n * BLOCK;
+            let blocks = layer.bias.len() / BLOCK;
+            let mut first = 0;
+            while first < blocks {
+                let g = (blocks - first).min(GROUP);
+                let w = &layer.weights[first * col..(first + g) * col];
+                let b = &layer.bias[first * BLOCK..(first + g) * BLOCK];
+                let (x1, x2) = (&cur1[..n], &cur2[..n]);
+                let range = first * BLOCK..(first + g) * BLOCK;
+                let (y1, y2) = (&mut next1[range.clone()], &mut next2[range]);
+                let act = layer.activation;
+                match g {
+                    4 => dense_group_pair::<4>(x1, x2, w, b, act, y1, y2),
+                    3 => dense_group_pair::<3>(x1, x2, w, b, act, y1, y2),
+                    2 => dense_group_pair::<2>(x1, x2, w, b, act, y1, y2),
+                    _ => dense_group_pair::<1>(x1, x2, w, b, act, y1, y2),
+                }
+                first += g;
+            }
+            std::mem::swap(&mut cur1, &mut next1);
+            std::mem::swap(&mut cur2, &mut next2);
+        }
+        let [o1, o2] = out;
+        let n = o1.len();
+        o1.copy_from_slice(&cur1[..n]);
+        o2.copy_from_slice(&cur2[..n]);
     }
 
     /// Convenience: one call that allocates its output.

@@ -115,3 +115,46 @@ fn folded_standardisation_equals_standardising_around_the_network() {
     let m = Mlp::from_network(&tanh_last).unwrap();
     assert!(m.fold_standardisation(&im, &is, &om, &os).is_err());
 }
+
+#[test]
+fn a_pair_of_inputs_gives_two_single_calls_bit_for_bit() {
+    let mut rng = Rng::new(11);
+    let lin = |inputs, outputs| LayerSpec::Linear { inputs, outputs };
+    // widths that fill whole groups of blocks, leave partial ones and need several groups
+    for layers in [
+        vec![
+            lin(22, 32),
+            LayerSpec::Relu,
+            lin(32, 32),
+            LayerSpec::Relu,
+            lin(32, 6),
+        ],
+        vec![
+            lin(13, 37),
+            LayerSpec::LeakyRelu { slope: 0.1 },
+            lin(37, 50),
+            LayerSpec::Tanh,
+            lin(50, 9),
+        ],
+        vec![lin(5, 3)],
+    ] {
+        let inputs = match layers[0] {
+            LayerSpec::Linear { inputs, .. } => inputs,
+            _ => unreachable!(),
+        };
+        let mlp = Mlp::from_network(&random_network(layers, inputs, &mut rng)).unwrap();
+        let n = mlp.outputs();
+        let (mut s1, mut s2) = (mlp.scratch(), mlp.scratch());
+        for m in [mlp.clone(), mlp.portable()] {
+            for _ in 0..30 {
+                let x1: Vec<f32> = (0..inputs).map(|_| rng.normal() as f32 * 2.0).collect();
+                let x2: Vec<f32> = (0..inputs).map(|_| rng.normal() as f32 * 2.0).collect();
+                let (mut o1, mut o2) = (vec![0.0f32; n], vec![0.0f32; n]);
+                m.forward_pair_into([&x1, &x2], [&mut s1, &mut s2], [&mut o1, &mut o2]);
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&o1), bits(&m.forward(&x1)));
+                assert_eq!(bits(&o2), bits(&m.forward(&x2)));
+            }
+        }
+    }
+}
