@@ -245,6 +245,11 @@ fn cached_map(key: MapKey, build: impl FnOnce() -> CvarMap) -> Arc<CvarMap> {
 }
 
 /// The time-to-goal cost's weights.
+/// The paper's roll/pitch limit (eq. 5), degrees: the default of [`TimeWeights::max_attitude`]
+/// and of the `pietra` system's `max_attitude_deg` (written once so the parameter list shows 30,
+/// not the 29.999999999999996 that converting the radians back gives).
+pub const MAX_ATTITUDE_DEG: f64 = 30.0;
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct TimeWeights {
     /// Goal radius within which a rollout stops accumulating time, m.
@@ -266,7 +271,7 @@ impl Default for TimeWeights {
         TimeWeights {
             goal_tolerance: 1.0,
             v_post: 0.1,
-            max_attitude: 30f64.to_radians(),
+            max_attitude: MAX_ATTITUDE_DEG.to_radians(),
             constraint: 1e3,
             obstacle: 1e3,
             ood: 0.0,

@@ -8,7 +8,7 @@
 
 use crate::dataset::WheelLayout;
 use crate::model::TravModel;
-use crate::planner::{CvarRollout, TimeToGoalCost, TimeWeights, TravSource};
+use crate::planner::{CvarRollout, MAX_ATTITUDE_DEG, TimeToGoalCost, TimeWeights, TravSource};
 use std::path::Path;
 use std::sync::{Arc, OnceLock};
 use verti_bench::{MobilitySystem, SystemInfo, SystemRegistry};
@@ -90,7 +90,7 @@ fn params() -> Vec<ParamSpec> {
         ),
         ParamSpec::float(
             "max_attitude_deg",
-            t.max_attitude.to_degrees(),
+            MAX_ATTITUDE_DEG,
             1.0,
             90.0,
             "roll/pitch limit on the CVaR of |roll|, |pitch| (eq. 5)",

@@ -151,3 +151,22 @@ fn pietra_drives_a_training_map_task() {
         );
     }
 }
+
+#[test]
+fn attitude_limit_parameter_reads_thirty_degrees() {
+    let mut registry = SystemRegistry::new();
+    verti_pietra::system::register(&mut registry, verti_pietra::shipped::pietra_v1).unwrap();
+    let info = registry.info("pietra").unwrap();
+    let spec = info
+        .params
+        .iter()
+        .find(|s| s.name == "max_attitude_deg")
+        .unwrap();
+    // shown as the paper's 30, and converting it gives the planner's own default exactly
+    assert_eq!(spec.default, ParamValue::Float(30.0));
+    assert_eq!(
+        30f64.to_radians(),
+        TimeWeights::default().max_attitude,
+        "the default limit"
+    );
+}
