@@ -151,21 +151,25 @@ pub fn summarize(results: &[TrialResult]) -> Summary {
     for (s, _) in &keys {
         *vehicles_per_system.entry(s).or_default() += 1;
     }
-    let systems = keys
+    let labelled: Vec<(String, Vec<&TrialResult>)> = keys
         .iter()
-        .zip(&groups)
+        .zip(groups)
         .map(|((s, v), trials)| {
             let name = if vehicles_per_system.get(s).copied().unwrap_or(0) > 1 {
                 format!("{s}/{v}")
             } else {
                 s.to_string()
             };
-            system_summary(name, trials)
+            (name, trials)
         })
         .collect();
     Summary {
         trials: results.len(),
-        systems,
+        systems: labelled
+            .iter()
+            .map(|(name, trials)| system_summary(name.clone(), trials))
+            .collect(),
+        paired: super::paired::paired(&labelled),
     }
 }
 

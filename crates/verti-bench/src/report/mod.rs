@@ -37,6 +37,7 @@
 //!
 //! * `aggregate`: [`summarize`], trials reduced to the types below.
 //! * `load`: [`load_results`], [`load_results_from`] and their error type.
+//! * `paired`: [`PairedComparison`]s, the sign test between systems on shared tasks.
 //! * `charts`: [`fig6_charts`] and its panel types.
 //! * `tables`: the summary as tables of text cells, shared by both writers.
 //! * `writers`: [`markdown`] and [`html`].
@@ -49,6 +50,7 @@ mod charts;
 #[cfg(test)]
 mod fixtures;
 mod load;
+mod paired;
 mod runs;
 mod tables;
 mod writers;
@@ -56,6 +58,7 @@ mod writers;
 pub use aggregate::summarize;
 pub use charts::{ChartPanel, ChartSeries, Fig6Metric, fig6_charts};
 pub use load::{Loaded, LoadedFile, ReportError, load_results, load_results_from};
+pub use paired::sign_test_p;
 pub use writers::{html, markdown, system_page, system_page_name};
 
 use crate::episode::TrialResult;
@@ -243,12 +246,33 @@ impl SystemSummary {
     }
 }
 
+/// Two systems on the tasks both ran (see `paired` for the test).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PairedComparison {
+    /// Column labels of the two systems, in report order.
+    pub a: String,
+    pub b: String,
+    /// Tasks both ran (same task number, world and start/goal pair).
+    pub common_tasks: usize,
+    /// Of those, tasks `a` reached and `b` did not, and the other way round.
+    pub only_a: usize,
+    pub only_b: usize,
+    /// (only_a − only_b) / √(only_a + only_b); `None` when no task separates them.
+    pub z: Option<f64>,
+    /// Two-sided exact sign test (McNemar); `None` when no task separates them.
+    pub p_value: Option<f64>,
+}
+
 /// The summary of a set of trials, systems side by side.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Summary {
     pub trials: usize,
     /// In the order each system (and vehicle) first appears in the results.
     pub systems: Vec<SystemSummary>,
+    /// Every pair of systems compared on their shared tasks, in report order (empty with one
+    /// system; absent in summaries written before it existed).
+    #[serde(default)]
+    pub paired: Vec<PairedComparison>,
 }
 
 #[cfg(test)]

@@ -113,6 +113,51 @@ pub(super) fn extra_table(summary: &Summary) -> Table {
     Table { header, rows }
 }
 
+/// One row per pair of systems: the tasks only one of them reached, and the sign test.
+pub(super) fn paired_table(summary: &Summary) -> Table {
+    let header = [
+        "",
+        "Common tasks",
+        "Only first succeeds",
+        "Only second succeeds",
+        "z",
+        "p (sign test)",
+    ]
+    .map(String::from)
+    .to_vec();
+    let rows = summary
+        .paired
+        .iter()
+        .map(|p| {
+            vec![
+                format!("{} vs {}", p.a, p.b),
+                p.common_tasks.to_string(),
+                p.only_a.to_string(),
+                p.only_b.to_string(),
+                num(p.z, 1),
+                p.p_value.map_or(NONE.to_string(), p_text),
+            ]
+        })
+        .collect();
+    Table { header, rows }
+}
+
+/// A p-value to two significant digits, tiny ones as a bound.
+fn p_text(p: f64) -> String {
+    if p < 1e-4 {
+        "< 0.0001".to_string()
+    } else if p < 0.01 {
+        format!("{p:.4}")
+    } else {
+        format!("{p:.2}")
+    }
+}
+
+pub(super) const PAIRED_NOTE: &str = "Each pair of systems on the tasks both ran (same task, \
+world and start/goal pair): the tasks exactly one of them reached. If the two were equally \
+good each such task would be a coin flip; p is the two-sided exact sign (McNemar) test, z = \
+(first − second) / √(first + second), |z| > 2 being unlikely by chance.";
+
 pub(super) const VARIANCE_NOTE: &str = "Cells: mean (population variance). Traversal time over \
 successful trials only; roll and pitch: each trial's mean absolute angle, then mean and \
 variance across all trials of the group.";

@@ -1,7 +1,9 @@
 //! Writers: the tables of `tables` as Markdown ([`markdown`]) and as a self-contained HTML
 //! page ([`html`]).
 
-use super::tables::{Table, VARIANCE_NOTE, extra_table, fig6_table, table_i};
+use super::tables::{
+    PAIRED_NOTE, Table, VARIANCE_NOTE, extra_table, fig6_table, paired_table, table_i,
+};
 use super::{Breakdown, Summary};
 use std::fmt::Write as _;
 
@@ -47,6 +49,11 @@ pub fn markdown(summary: &Summary) -> String {
         md_table(&mut out, &fig6_table(summary, b));
     }
     let _ = writeln!(out, "\n{VARIANCE_NOTE}");
+    if !summary.paired.is_empty() {
+        out.push_str("\n## Paired comparison: tasks only one system reached\n\n");
+        md_table(&mut out, &paired_table(summary));
+        let _ = writeln!(out, "\n{PAIRED_NOTE}");
+    }
     out.push_str("\n## Other metrics\n\n");
     md_table(&mut out, &extra_table(summary));
     out.push_str(
@@ -121,6 +128,7 @@ pub fn system_page(summary: &Summary, index: usize) -> Option<String> {
     let alone = Summary {
         trials: one.outcomes.trials,
         systems: vec![one.clone()],
+        paired: Vec::new(),
     };
     let mut out = html_with(
         &alone,
@@ -195,6 +203,11 @@ fn html_with(summary: &Summary, figures: &[(&str, &str)], heading: &str, links: 
             html_table(&mut out, &fig6_table(summary, b));
         }
         let _ = writeln!(out, "<p class=\"note\">{}</p>", esc(VARIANCE_NOTE));
+        if !summary.paired.is_empty() {
+            out.push_str("<h2>Paired comparison: tasks only one system reached</h2>\n");
+            html_table(&mut out, &paired_table(summary));
+            let _ = writeln!(out, "<p class=\"note\">{}</p>", esc(PAIRED_NOTE));
+        }
         out.push_str("<h2>Other metrics</h2>\n");
         html_table(&mut out, &extra_table(summary));
     }
@@ -218,6 +231,15 @@ mod tests {
         assert!(md.contains("| Traversal time (s) | 25.00 | – |"), "{md}");
         // low elevation, A: roll mean 3 variance 1; B: no trials
         assert!(md.contains("| low: roll (°) | 3.00 (1.00) | – |"), "{md}");
+        // the pair's row: its three columns, then a dash for z and p where no task separates
+        // them, or numbers where one does
+        let p = &s.paired[0];
+        let row = format!(
+            "| A vs B | {} | {} | {} |",
+            p.common_tasks, p.only_a, p.only_b
+        );
+        assert!(md.contains(&row), "{md}");
+        assert!(md.contains("sign (McNemar) test"), "{md}");
         let mut odd = sample();
         odd[0].system = "<x|y>".into();
         let h = html(&summarize(&odd), &[("Fig. 6 <all>", "fig6.png")]);
@@ -238,6 +260,7 @@ mod tests {
             h.contains("<th>B</th>") && !own.contains("<th>B</th>"),
             "{own}"
         );
+        assert!(h.contains("Paired comparison") && !own.contains("Paired comparison"));
         assert!(system_page(&summarize(&odd), 9).is_none());
     }
 }
