@@ -244,12 +244,12 @@ fn cached_map(key: MapKey, build: impl FnOnce() -> CvarMap) -> Arc<CvarMap> {
     map
 }
 
-/// The time-to-goal cost's weights.
 /// The paper's roll/pitch limit (eq. 5), degrees: the default of [`TimeWeights::max_attitude`]
 /// and of the `pietra` system's `max_attitude_deg` (written once so the parameter list shows 30,
 /// not the 29.999999999999996 that converting the radians back gives).
 pub const MAX_ATTITUDE_DEG: f64 = 30.0;
 
+/// The time-to-goal cost's weights.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TimeWeights {
     /// Goal radius within which a rollout stops accumulating time, m.

@@ -58,7 +58,6 @@ mod writers;
 pub use aggregate::summarize;
 pub use charts::{ChartPanel, ChartSeries, Fig6Metric, fig6_charts};
 pub use load::{Loaded, LoadedFile, ReportError, load_results, load_results_from};
-pub use paired::sign_test_p;
 pub use writers::{html, markdown, system_page, system_page_name};
 
 use crate::episode::TrialResult;

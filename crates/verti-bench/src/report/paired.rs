@@ -62,7 +62,7 @@ pub(super) fn paired(systems: &[(String, Vec<&TrialResult>)]) -> Vec<PairedCompa
 
 /// Two-sided exact sign test: the probability, with `a + b` fair coins, of a split at least as
 /// uneven as `a` against `b` (twice the smaller tail, at most 1).
-pub fn sign_test_p(a: usize, b: usize) -> f64 {
+fn sign_test_p(a: usize, b: usize) -> f64 {
     let n = a + b;
     let k = a.min(b);
     // the tail sum of C(n, i) / 2^n for i <= k, each term in logs so large n cannot overflow

@@ -142,7 +142,7 @@ pub(super) fn paired_table(summary: &Summary) -> Table {
     Table { header, rows }
 }
 
-/// A p-value to two significant digits, tiny ones as a bound.
+/// A p-value to two decimals, four below 0.01, and tiny ones as a bound.
 fn p_text(p: f64) -> String {
     if p < 1e-4 {
         "< 0.0001".to_string()

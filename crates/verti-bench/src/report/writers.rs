@@ -231,8 +231,7 @@ mod tests {
         assert!(md.contains("| Traversal time (s) | 25.00 | – |"), "{md}");
         // low elevation, A: roll mean 3 variance 1; B: no trials
         assert!(md.contains("| low: roll (°) | 3.00 (1.00) | – |"), "{md}");
-        // the pair's row: its three columns, then a dash for z and p where no task separates
-        // them, or numbers where one does
+        // the pair's row starts with its three counts, and the note explains the test
         let p = &s.paired[0];
         let row = format!(
             "| A vs B | {} | {} | {} |",
