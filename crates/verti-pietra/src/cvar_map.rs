@@ -356,9 +356,17 @@ mod tests {
 
     #[test]
     fn fast_build_equals_one_footprint_at_a_time_bit_for_bit() {
-        // a rough test map, the shipped model and the prior alone; 37 columns: a whole chunk
-        // of the batch path, a part chunk, and footprints reaching past the map's edge
+        // a rough test map, the shipped model, the three baselines of Fig. 7 (no evidence
+        // scaling, uniform prior, no flow) and the prior alone; 37 columns: a whole chunk of
+        // the batch path, a part chunk with a part group of lanes, and footprints reaching
+        // past the map's edge
         let model = crate::shipped::pietra_v1().unwrap();
+        let models = ["evora-v1", "pi-v1", "vanilla-v1"].map(|name| {
+            let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+            crate::model::TravModel::load(&dir.join(format!("{name}.yaml"))).unwrap()
+        });
+        let mut sources = vec![Source::Model(&model), Source::Physics];
+        sources.extend(models.iter().map(Source::Model));
         let world = &crate::maps::split_maps(crate::maps::Split::Test)[0];
         let t = &world.terrain;
         let half = t.half_extent();
@@ -367,7 +375,7 @@ mod tests {
             (Region::around(half - 4.0, 3.0 - half, 0.39, 37, 4), 0.2),
         ] {
             let spec = spec(alpha);
-            for source in [Source::Model(&model), Source::Physics] {
+            for &source in &sources {
                 let fast = CvarMap::build(t, &spec, source, region);
                 let slow = CvarMap::build_reference(t, &spec, source, region);
                 assert_eq!(fast.ood, slow.ood);

@@ -23,6 +23,7 @@ mod map_rows;
 mod map_simd;
 pub mod maps;
 pub mod model;
+mod model_lanes;
 pub mod planner;
 pub mod prior;
 pub mod shipped;

@@ -18,6 +18,7 @@ use crate::dataset::{
     FEATURES, PATCH_CELL, PATCH_LENGTH, PATCH_WIDTH, SLOPE_BASE, height_at, height_on_grid,
 };
 use crate::model::TravModel;
+use crate::model_lanes::{LANES, LaneInput, Lanes, finish_cvars};
 use crate::prior::{Footprint, physics_prior};
 use verti_world::Heightfield;
 
@@ -172,7 +173,7 @@ struct Scratch {
     z: Vec<f32>,
     logits: Vec<[[f32; B]; PARAMS]>,
     scale: Vec<[f32; PARAMS]>,
-    flow: Vec<f64>,
+    flow: Vec<Lanes>,
     one: Option<crate::model::TravScratch>,
 }
 
@@ -261,7 +262,9 @@ fn row_body(
 }
 
 /// The model's CVaRs and OOD flags of the `physics.len()` footprints whose features are in
-/// `s.features`, handed to `put(index, cvars, ood)`.
+/// `s.features`, handed to `put(index, cvars, ood)`. Inlined into the row, so that an AVX2
+/// row runs the lanes of [`finish_cvars`] in 256-bit vectors.
+#[inline(always)]
 fn model_chunk(
     m: &TravModel,
     physics: &[[Pmf; PARAMS]],
@@ -303,18 +306,18 @@ fn model_chunk(
             s.scale[j].copy_from_slice(&l[j * ls..][..PARAMS]);
         }
     }
-    for (j, p) in physics.iter().enumerate() {
-        let pred = m.finish(
-            &s.z[j * latent..][..latent],
-            &s.logits[j],
-            &s.scale[j],
-            p,
-            &mut s.flow,
-        );
-        put(
-            j,
-            pmf_cvars(&pred.pmf, spec),
-            pred.log_density < m.card.ood_log_density,
-        );
+    for j0 in (0..n).step_by(LANES) {
+        // a last group of fewer than four repeats its last footprint in the spare lanes
+        let lane = |l: usize| (j0 + l).min(n - 1);
+        let input = std::array::from_fn(|l| LaneInput {
+            z: &s.z[lane(l) * latent..][..latent],
+            logits: &s.logits[lane(l)],
+            scale: &s.scale[lane(l)],
+            physics: &physics[lane(l)],
+        });
+        let (cvars, log_density) = finish_cvars(m, input, &spec.bins, spec.alpha, &mut s.flow);
+        for l in 0..LANES.min(n - j0) {
+            put(j0 + l, cvars[l], log_density[l] < m.card.ood_log_density);
+        }
     }
 }

@@ -99,7 +99,7 @@ pub struct TravPrediction {
 }
 
 #[inline]
-fn softplus(x: f64) -> f64 {
+pub(crate) fn softplus(x: f64) -> f64 {
     if x > 20.0 { x } else { x.exp().ln_1p() }
 }
 
@@ -251,6 +251,11 @@ impl TravModel {
             z: vec![0.0; self.card.latent],
             flow: Vec::with_capacity(self.card.latent),
         }
+    }
+
+    /// The radial flow's α and β per layer, after the softplus.
+    pub(crate) fn flow(&self) -> (&[f64], &[f64]) {
+        (&self.alpha, &self.beta)
     }
 
     /// log p(z) under the radial flow with a standard normal base.
