@@ -15,12 +15,28 @@
 //!   atom with positive mass.
 
 use crate::bins::{B, Pmf};
-use crate::model_lanes::{LANES, Lanes};
+use crate::model_lanes::{LANES, Lanes, sum_start};
 
 /// Mass of one bin after the "negative or NaN counts as 0" rule.
 #[inline]
 fn mass(p: f64) -> f64 {
     if p > 0.0 { p } else { 0.0 }
+}
+
+/// What a PMF with no usable mass gets: the plain mean of `values`.
+#[inline]
+fn uniform_mean(values: &[f64; B]) -> f64 {
+    values.iter().sum::<f64>() / B as f64
+}
+
+/// α as the tails use it: above 1 is 1, and 0, negative or NaN the smallest positive α.
+#[inline]
+fn tail_fraction(alpha: f64) -> f64 {
+    if alpha > 0.0 {
+        alpha.min(1.0)
+    } else {
+        f64::MIN_POSITIVE
+    }
 }
 
 /// Mean of the worst α fraction of the mass, visiting bins in `order` (worst first).
@@ -29,13 +45,9 @@ fn mass(p: f64) -> f64 {
 fn tail(p: &Pmf, values: &[f64; B], alpha: f64, order: [usize; B], exact: bool) -> f64 {
     let total: f64 = p.iter().map(|&x| mass(x)).sum();
     if !(total > 0.0 && total.is_finite()) {
-        return values.iter().sum::<f64>() / B as f64;
+        return uniform_mean(values);
     }
-    let alpha = if alpha > 0.0 {
-        alpha.min(1.0)
-    } else {
-        f64::MIN_POSITIVE
-    };
+    let alpha = tail_fraction(alpha);
     let (mut cum, mut acc) = (0.0, 0.0);
     let mut last = order[0];
     for b in order {
@@ -71,17 +83,13 @@ fn tail(p: &Pmf, values: &[f64; B], alpha: f64, order: [usize; B], exact: bool) 
 #[inline(always)]
 pub(crate) fn cvar_lanes(p: &[Lanes; B], values: &[f64; B], alpha: f64, left: bool) -> Lanes {
     let order = if left { ascending() } else { descending() };
-    let mut total: Lanes = [std::iter::empty::<f64>().sum(); LANES];
+    let mut total: Lanes = [sum_start(); LANES];
     for q in p {
         for l in 0..LANES {
             total[l] += mass(q[l]);
         }
     }
-    let alpha = if alpha > 0.0 {
-        alpha.min(1.0)
-    } else {
-        f64::MIN_POSITIVE
-    };
+    let alpha = tail_fraction(alpha);
     let (mut cum, mut acc) = ([0.0; LANES], [0.0; LANES]);
     let mut last = [order[0]; LANES];
     let mut done = [false; LANES];
@@ -103,7 +111,7 @@ pub(crate) fn cvar_lanes(p: &[Lanes; B], values: &[f64; B], alpha: f64, left: bo
     // `tail`'s return at the crossing atom and after the loop are the same expression
     std::array::from_fn(|l| {
         if !(total[l] > 0.0 && total[l].is_finite()) {
-            values.iter().sum::<f64>() / B as f64
+            uniform_mean(values)
         } else {
             acc[l] / alpha + (1.0 - cum[l] / alpha) * values[last[l]]
         }

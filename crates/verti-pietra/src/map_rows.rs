@@ -6,6 +6,8 @@
 //!   wheel and patch point of each footprint;
 //! * the patches of up to [`CHUNK`] cells of one heading go through each network together,
 //!   as matrix-matrix products ([`crate::batch_mlp`]);
+//! * the tail after the networks (softmaxes, flow density, posterior, CVaRs) runs four
+//!   footprints side by side ([`crate::model_lanes`]);
 //! * buffers live in one scratch per row, nothing is allocated per footprint.
 //!
 //! [`CvarMap::build`]: crate::cvar_map::CvarMap::build

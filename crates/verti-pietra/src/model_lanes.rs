@@ -20,9 +20,10 @@ pub(crate) const LANES: usize = 4;
 /// One value per lane.
 pub(crate) type Lanes = [f64; LANES];
 
-/// Where `Iterator::sum` of f64 starts (−0.0 in current Rust), so that lane sums equal it.
+/// Where `Iterator::sum` of f64 starts (−0.0 in current Rust), so that sums written out by
+/// hand, lane by lane, equal it.
 #[inline(always)]
-fn sum_start() -> f64 {
+pub(crate) fn sum_start() -> f64 {
     std::iter::empty::<f64>().sum()
 }
 
@@ -68,44 +69,42 @@ pub(crate) fn finish_cvars(
             }
         }
     }
-    let pmf = if !c.evidential {
-        learned
-    } else {
-        let log_density = log_density_lanes(m, &input, flow);
-        let mut pmf = [[[0.0; LANES]; B]; PARAMS];
-        let log_n: Lanes = std::array::from_fn(|l| {
-            (log_density[l] + c.log_budget).clamp(-c.log_evidence_clamp, c.log_evidence_clamp)
-        });
-        let u = uniform();
-        for k in 0..PARAMS {
-            let n: Lanes = std::array::from_fn(|l| {
-                let mut ln = log_n[l];
-                if c.scales_evidence {
-                    ln += -crate::model::softplus(-f64::from(input[l].scale[k]));
-                }
-                ln.exp()
-            });
-            let mut total = [0.0; LANES];
-            for b in 0..B {
-                for l in 0..LANES {
-                    let prior = if c.physics_in_posterior {
-                        input[l].physics[k][b]
-                    } else {
-                        u[b]
-                    };
-                    pmf[k][b][l] = c.prior_evidence * prior + n[l] * learned[k][b][l];
-                    total[l] += pmf[k][b][l];
-                }
+    if !c.evidential {
+        return (cvars(&learned, bins, alpha), [f64::NAN; LANES]);
+    }
+    let log_density = log_density_lanes(m, &input, flow);
+    let mut pmf = [[[0.0; LANES]; B]; PARAMS];
+    let log_n: Lanes = std::array::from_fn(|l| {
+        (log_density[l] + c.log_budget).clamp(-c.log_evidence_clamp, c.log_evidence_clamp)
+    });
+    let u = uniform();
+    for k in 0..PARAMS {
+        let n: Lanes = std::array::from_fn(|l| {
+            let mut ln = log_n[l];
+            if c.scales_evidence {
+                ln += -crate::model::softplus(-f64::from(input[l].scale[k]));
             }
-            for p in pmf[k].iter_mut() {
-                for l in 0..LANES {
-                    p[l] /= total[l];
-                }
+            ln.exp()
+        });
+        let mut total = [0.0; LANES];
+        for b in 0..B {
+            for l in 0..LANES {
+                let prior = if c.physics_in_posterior {
+                    input[l].physics[k][b]
+                } else {
+                    u[b]
+                };
+                pmf[k][b][l] = c.prior_evidence * prior + n[l] * learned[k][b][l];
+                total[l] += pmf[k][b][l];
             }
         }
-        return (cvars(&pmf, bins, alpha), log_density);
-    };
-    (cvars(&pmf, bins, alpha), [f64::NAN; LANES])
+        for p in pmf[k].iter_mut() {
+            for l in 0..LANES {
+                p[l] /= total[l];
+            }
+        }
+    }
+    (cvars(&pmf, bins, alpha), log_density)
 }
 
 /// `pmf_cvars` of four footprints: left tails of the tractions, right tails of the attitudes.
