@@ -201,6 +201,7 @@ pub struct TrialResult {
     pub rules: Rules,
     pub outcome: Outcome,
     /// Simulated time at the end of the trial, seconds.
+    #[serde(with = "crate::nullable")]
     pub time: f64,
     /// Time to reach the goal (successes only).
     pub traversal_time: Option<f64>,
@@ -210,14 +211,18 @@ pub struct TrialResult {
     pub throttle: SignalStats,
     pub steering: SignalStats,
     /// Planar distance driven, metres.
+    #[serde(with = "crate::nullable")]
     pub path_length: f64,
     /// Planar distance from the goal at the end, metres.
+    #[serde(with = "crate::nullable")]
     pub final_distance: f64,
     /// |roll| at the end, degrees.
+    #[serde(with = "crate::nullable")]
     pub final_roll: f64,
     /// Why an `error` trial failed.
     pub error: Option<String>,
     /// Wall-clock seconds this trial took (the only field that varies between runs).
+    #[serde(with = "crate::nullable")]
     pub wall_time: f64,
 }
 

@@ -197,6 +197,12 @@ pub fn select_tasks(
     Ok(out)
 }
 
+/// One line of a results file (without its newline): the only way results are written, so
+/// every reader ([`read_results`]) accepts every line (non-finite numbers are `null`).
+pub fn result_line(r: &TrialResult) -> String {
+    serde_json::to_string(r).expect("results serialise")
+}
+
 /// Reads a results file; a torn last line (from a kill) is dropped and reported as `false`.
 pub fn read_results(path: &Path) -> Result<(Vec<TrialResult>, bool), EvalError> {
     read_results_file(path).map(|(results, clean, _)| (results, clean))
@@ -249,6 +255,15 @@ pub struct EvalSetup<'a> {
     /// Overwrite an existing results file instead of refusing.
     pub force: bool,
     pub run: RunInfo,
+    /// The files the system loads when it drives the given tasks (world position, pair), by
+    /// content ([`crate::identity::system_inputs`]): recorded, and compared on resume. Called
+    /// once the run's tasks are known (a resume may take them from `run.json`).
+    #[allow(clippy::type_complexity)]
+    pub inputs: Option<
+        &'a (dyn Fn(&[(usize, u32)]) -> Result<Vec<crate::identity::InputFile>, EvalError> + Sync),
+    >,
+    /// The split this run is a shard of (`--shard`), recorded for `verti merge`.
+    pub shard: Option<crate::identity::SplitRecord>,
     /// Optional per-step logs.
     pub step_log: Option<StepLogSink<'a>>,
     /// Raised to stop the run: trials that finish after it is raised are not recorded (they
@@ -332,6 +347,7 @@ pub fn evaluate(
         .as_deref()
         .filter(|m| !m.is_none())
         .cloned();
+    record.shard = setup.shard.clone();
 
     let mut previous = Vec::new();
     if results_path.exists() && !setup.force {
@@ -365,6 +381,10 @@ pub fn evaluate(
                 recorded_selection.dedup();
             }
         }
+        record.inputs = match setup.inputs {
+            Some(inputs) => inputs(&select_tasks(setup.worlds, &selection)?)?,
+            None => Vec::new(),
+        };
         let differences = record.differences(&before);
         if !differences.is_empty() {
             return Err(EvalError::Argument(format!(
@@ -394,13 +414,17 @@ pub fn evaluate(
             // line instead of being glued to the last result
             let mut text = String::new();
             for r in &rs {
-                text.push_str(&serde_json::to_string(r).expect("results serialise"));
+                text.push_str(&result_line(r));
                 text.push('\n');
             }
             std::fs::write(&results_path, text).map_err(io(&results_path))?;
         }
         previous = rs;
     } else {
+        // before anything is written: a file that cannot be read fails the run here
+        if let Some(inputs) = setup.inputs {
+            record.inputs = inputs(&select_tasks(setup.worlds, &selection)?)?;
+        }
         std::fs::write(&results_path, "").map_err(io(&results_path))?;
         // a fresh start keeps no step logs of an earlier run in this directory
         if steps_path.exists() {
@@ -484,7 +508,7 @@ pub fn evaluate(
                 if cancelled() {
                     return Err(EvalError::Cancelled);
                 }
-                let mut line = serde_json::to_string(&r).expect("results serialise");
+                let mut line = result_line(&r);
                 line.push('\n');
                 {
                     let mut f = sink.lock().unwrap_or_else(|p| p.into_inner());

@@ -68,6 +68,72 @@ pub fn step_log_label(seconds: Option<f64>) -> Option<String> {
     })
 }
 
+/// A file the system loads (a model card, its weights), by content: [`input_files`].
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct InputFile {
+    /// The path as the system was given it.
+    pub path: String,
+    /// [`Digest::of_file`] of its bytes.
+    pub digest: String,
+}
+
+/// The files `paths` by content, sorted by path, each once; an unreadable file is an error
+/// naming it.
+pub fn input_files(paths: &[std::path::PathBuf]) -> Result<Vec<InputFile>, EvalError> {
+    let mut out: Vec<InputFile> = Vec::with_capacity(paths.len());
+    for p in paths {
+        let digest = Digest::of_file(p).map_err(|source| EvalError::Io {
+            path: p.clone(),
+            source,
+        })?;
+        out.push(InputFile {
+            path: p.display().to_string(),
+            digest,
+        });
+    }
+    out.sort_by(|a, b| a.path.cmp(&b.path));
+    out.dedup_by(|a, b| a.path == b.path);
+    Ok(out)
+}
+
+/// The files system `name` of `registry` loads with `params` when it drives `tasks` (world
+/// position, pair) of `worlds`, by content: what [`crate::eval::EvalSetup::inputs`] takes.
+pub fn system_inputs(
+    registry: &crate::system::SystemRegistry,
+    name: &str,
+    params: &verti_core::params::Params,
+    worlds: &[Arc<World>],
+    tasks: &[(usize, u32)],
+) -> Result<Vec<InputFile>, EvalError> {
+    let mut indices: Vec<u32> = tasks.iter().map(|&(wi, _)| worlds[wi].meta.index).collect();
+    indices.sort_unstable();
+    indices.dedup();
+    let paths = registry
+        .inputs(name, params, &indices)
+        .map_err(|e| EvalError::Argument(e.to_string()))?;
+    input_files(&paths)
+}
+
+/// The split a run is one part of (`verti eval --shard INDEX/COUNT`): the shard and the whole
+/// selection it was cut from, so that `verti merge` can tell whether its shards cover it.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SplitRecord {
+    pub index: usize,
+    pub count: usize,
+    /// The selection the split divides, as task ranges (`1-1000`).
+    pub of: String,
+}
+
+impl std::fmt::Display for SplitRecord {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "shard {}/{} of tasks {}",
+            self.index, self.count, self.of
+        )
+    }
+}
+
 /// `OUT/run.json`: the run's settings as given, what they resolved to by content, and the
 /// tasks the run covers.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -97,6 +163,17 @@ pub struct RunRecord {
     /// Perception noise on what the system observed (absent: ground truth).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub perception: Option<crate::perception::PerceptionModel>,
+    /// Every file the system loads, by content (absent in runs recorded before, and in runs
+    /// of systems that load none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub inputs: Vec<InputFile>,
+    /// The split this run is one shard of (absent: a whole run).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<SplitRecord>,
+    /// Tasks of the selection with no result: a merge of shards that did not cover it, made
+    /// with `--allow-partial` (`verti eval --resume` on the merged directory runs them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub missing: Option<String>,
 }
 
 impl RunRecord {
@@ -117,6 +194,9 @@ impl RunRecord {
             step_log: step_log_label(step_log),
             tasks: None,
             perception: None,
+            inputs: Vec::new(),
+            shard: None,
+            missing: None,
         }
     }
 
@@ -208,8 +288,50 @@ impl RunRecord {
         if a.system == b.system {
             out.extend(param_differences(&b.params, &a.params));
         }
+        out.extend(input_differences(&recorded.inputs, &self.inputs));
+        let split =
+            |s: &Option<SplitRecord>| s.as_ref().map_or("a whole run".into(), |s| s.to_string());
+        differ(
+            &mut out,
+            "split",
+            split(&recorded.shard),
+            split(&self.shard),
+        );
         out
     }
+}
+
+/// Files loaded now and by the recorded run that differ by content, or that only one of them
+/// loads. A record from before inputs were recorded (none) is compared by parameters only.
+fn input_differences(recorded: &[InputFile], now: &[InputFile]) -> Vec<String> {
+    if recorded.is_empty() {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for f in now {
+        match recorded.iter().find(|r| r.path == f.path) {
+            Some(r) if r.digest != f.digest => out.push(format!(
+                "file `{}`: its contents changed (digest {} recorded, {} now)",
+                f.path,
+                short(&r.digest),
+                short(&f.digest)
+            )),
+            Some(_) => {}
+            None => out.push(format!(
+                "file `{}`: loaded now, not by the recorded run",
+                f.path
+            )),
+        }
+    }
+    for r in recorded {
+        if !now.iter().any(|f| f.path == r.path) {
+            out.push(format!(
+                "file `{}`: loaded by the recorded run, not now",
+                r.path
+            ));
+        }
+    }
+    out
 }
 
 /// Notes `what` in `out` when its recorded and current values differ.

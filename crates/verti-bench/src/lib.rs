@@ -23,6 +23,7 @@ pub mod eval;
 pub mod features;
 pub mod identity;
 pub mod metrics;
+mod nullable;
 pub mod observation;
 pub mod path;
 pub mod perception;

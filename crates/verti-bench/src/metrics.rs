@@ -7,9 +7,12 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Stats {
     pub count: u64,
+    #[serde(with = "crate::nullable")]
     pub mean: f64,
     /// Population variance.
+    #[serde(with = "crate::nullable")]
     pub var: f64,
+    #[serde(with = "crate::nullable")]
     pub max: f64,
 }
 
@@ -37,9 +40,12 @@ impl Stats {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SignalStats {
     pub samples: u64,
+    #[serde(with = "crate::nullable")]
     pub mean_abs: f64,
+    #[serde(with = "crate::nullable")]
     pub total_variation: f64,
     /// The latest sample (needed to continue the total variation).
+    #[serde(with = "crate::nullable")]
     pub last: f64,
 }
 

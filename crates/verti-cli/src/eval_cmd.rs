@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use verti_bench::episode::{EpisodeLog, Outcome, Rules, StartMode};
 use verti_bench::eval::{EvalSetup, RunInfo, evaluate, parse_tasks};
+use verti_bench::identity::SplitRecord;
 use verti_bench::{EpisodeConfig, run_episode};
 use verti_world::World;
 
@@ -169,7 +170,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
     }
     let set_name = set.name.clone();
     let worlds: Vec<Arc<World>> = set.worlds.into_iter().map(Arc::new).collect();
-    let selection = shard_selection(&worlds, &a.tasks, a.shard)?;
+    let (selection, split) = shard_selection(&worlds, &a.tasks, a.shard)?;
     let per_system = verti_bench::eval::select_tasks(&worlds, &selection)?.len();
     // one progress display for the whole sequence
     let pb = bar((per_system * systems.len()) as u64, &systems.join(", "));
@@ -189,6 +190,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
             scale,
             set_name: &set_name,
             pb: &pb,
+            shard: split.clone(),
         };
         let lines = eval_system(&a, system, params, &shared, &out)?;
         for line in lines {
@@ -205,15 +207,16 @@ pub fn eval(a: EvalArgs) -> CmdResult {
 }
 
 /// The task numbers a run covers: `--tasks`, cut to `--shard` where given (an explicit list,
-/// so a shard's run.json records exactly its tasks and resumes them).
+/// so a shard's run.json records exactly its tasks and resumes them), and the split it is a
+/// shard of (recorded, so that `verti merge` can check its shards cover the selection).
 fn shard_selection(
     worlds: &[Arc<World>],
     tasks: &str,
     shard: Option<verti_bench::shard::Shard>,
-) -> Result<Vec<u32>, verti_bench::eval::EvalError> {
+) -> Result<(Vec<u32>, Option<SplitRecord>), verti_bench::eval::EvalError> {
     let selection = parse_tasks(tasks)?;
     let Some(shard) = shard else {
-        return Ok(selection);
+        return Ok((selection, None));
     };
     let all: Vec<u32> = if selection.is_empty() {
         verti_bench::eval::select_tasks(worlds, &[])?
@@ -232,7 +235,12 @@ fn shard_selection(
             all.len()
         )));
     }
-    Ok(mine)
+    let split = SplitRecord {
+        index: shard.index,
+        count: shard.count,
+        of: verti_bench::eval::format_tasks(&all),
+    };
+    Ok((mine, Some(split)))
 }
 
 /// What every system of one `verti eval` shares.
@@ -245,6 +253,8 @@ struct Shared<'a> {
     scale: f64,
     set_name: &'a str,
     pb: &'a indicatif::ProgressBar,
+    /// The split the run is a shard of (`--shard`).
+    shard: Option<SplitRecord>,
 }
 
 /// One system's evaluation; returns its summary lines.
@@ -273,6 +283,9 @@ fn eval_system(
         let path = steps_dir.join(verti_log::log_file_name(r.task));
         verti_log::write_steps(&path, r, &log.steps).map_err(|e| e.to_string())
     };
+    let inputs = |tasks: &[(usize, u32)]| {
+        verti_bench::identity::system_inputs(registry, system, &params, worlds, tasks)
+    };
     let setup = EvalSetup {
         worlds,
         vehicle,
@@ -281,6 +294,8 @@ fn eval_system(
         out: out.to_path_buf(),
         resume: a.resume,
         force: a.force,
+        inputs: Some(&inputs),
+        shard: sh.shard.clone(),
         run: RunInfo {
             system: system.to_string(),
             params: params.clone(),

@@ -52,9 +52,26 @@ pub fn run(cmd: KinoCommand) -> Result<(), Box<dyn std::error::Error>> {
             let geometry = geometry_of(&a.data)?;
             let mut results = Vec::new();
             let mut dt_world = 0.0;
+            if a.horizon == 0 {
+                return Err("--horizon must be at least 1 model step".into());
+            }
             for f in files {
                 let data = KinoData::load(&a.data, f.card.dt)?;
                 dt_world = data.dt_world;
+                // a prediction needs the step before it and `horizon` steps after it: with no
+                // trajectory that long the table would be empty, which is no answer
+                let longest = data.trajectories.iter().map(|t| t.poses.len()).max();
+                if longest.is_none_or(|n| n < a.horizon + 2) {
+                    return Err(format!(
+                        "{}: no trajectory is long enough for --horizon {} at the model's {} s steps (the longest has {} steps, {} needed): use a shorter --horizon",
+                        a.data.display(),
+                        a.horizon,
+                        f.card.dt,
+                        longest.unwrap_or(0),
+                        a.horizon + 2
+                    )
+                    .into());
+                }
                 results.push(evaluate(
                     &data,
                     &Predictor::Model(KinoModel::new(f)),

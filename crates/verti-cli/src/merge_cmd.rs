@@ -15,24 +15,33 @@ pub struct MergeArgs {
     /// Overwrite an existing results file in --out.
     #[arg(long)]
     force: bool,
-    /// Join even if some shard has unfinished tasks (they are listed); by default that fails,
-    /// so a half-finished cluster run is not mistaken for a whole one.
-    #[arg(long)]
-    partial: bool,
+    /// Join even if the shards do not cover the whole selection (a shard not given, or one
+    /// with unfinished tasks): the missing tasks are listed here and recorded in the merged
+    /// run.json (`missing`), and `verti eval --resume --out DIR` on the merged directory runs
+    /// them. By default that fails, so a half-finished cluster run is not mistaken for a
+    /// whole one.
+    #[arg(long, alias = "partial")]
+    allow_partial: bool,
 }
 
 pub fn merge(a: MergeArgs) -> CmdResult {
     let joined = verti_bench::shard::join(&a.shards)?;
-    if !joined.unfinished.is_empty() {
-        let message = unfinished_message(&joined.unfinished);
-        if !a.partial {
-            return Err(message.into());
+    if let Some(message) = joined.coverage() {
+        if !a.allow_partial {
+            return Err(
+                format!("{message}; or pass --allow-partial to merge what is there").into(),
+            );
         }
         eprintln!("warning: {message}");
     }
-    joined.write(&a.out, a.force)?;
+    if joined.unchecked {
+        eprintln!(
+            "warning: these shards were written before verti recorded splits: whether they cover the whole selection cannot be checked (only their own unfinished tasks are known)"
+        );
+    }
+    joined.write(&a.out, a.force, &verti_log::log_file_name)?;
     println!(
-        "merged {} shard(s): {} results{} -> {}",
+        "merged {} shard(s): {} results{}{} -> {}",
         a.shards.len(),
         joined.results().len(),
         if joined.duplicates > 0 {
@@ -43,27 +52,15 @@ pub fn merge(a: MergeArgs) -> CmdResult {
         } else {
             String::new()
         },
+        if joined.missing.is_empty() {
+            String::new()
+        } else {
+            format!(
+                ", {} task(s) missing (listed in run.json)",
+                joined.missing.len()
+            )
+        },
         a.out.join(verti_bench::eval::RESULTS_FILE).display()
     );
     Ok(())
-}
-
-fn unfinished_message(unfinished: &[(u32, PathBuf)]) -> String {
-    let mut dirs: Vec<String> = unfinished
-        .iter()
-        .map(|(_, d)| d.display().to_string())
-        .collect();
-    dirs.sort();
-    dirs.dedup();
-    let shown: Vec<String> = unfinished
-        .iter()
-        .take(8)
-        .map(|(n, _)| n.to_string())
-        .collect();
-    format!(
-        "{} selected task(s) have no result (e.g. {}): resume {} with `verti eval ... --resume --out DIR`, or pass --partial to merge what is there",
-        unfinished.len(),
-        shown.join(", "),
-        dirs.join(", ")
-    )
 }

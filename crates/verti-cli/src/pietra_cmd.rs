@@ -197,6 +197,9 @@ fn navigate(a: &NavigateArgs) -> Result<(), String> {
     for ((m, alpha), params) in runs.iter().zip(resolved) {
         pb.set_message(format!("{m} α {alpha}"));
         let out = a.out.join(format!("{m}-a{alpha}"));
+        let inputs = |tasks: &[(usize, u32)]| {
+            verti_bench::identity::system_inputs(&registry, "pietra", &params, &worlds, tasks)
+        };
         let setup = EvalSetup {
             worlds: &worlds,
             vehicle: &vehicle,
@@ -218,6 +221,8 @@ fn navigate(a: &NavigateArgs) -> Result<(), String> {
                 seed: 0,
                 max_time: a.max_time,
             },
+            inputs: Some(&inputs),
+            shard: None,
             step_log: None,
             cancel: None,
             warn: None,

@@ -89,7 +89,7 @@ fn shards_merge_into_what_one_run_writes() {
     let again = eval(&merged, &["--resume"]);
     assert!(again.contains("24 tasks"), "{again}");
 
-    // a shard with an unfinished task is refused unless --partial
+    // a shard with an unfinished task is refused unless --allow-partial
     let shard0 = std::fs::read_to_string(shards[0].join("results.jsonl")).unwrap();
     let cut: String = shard0.lines().skip(1).map(|l| format!("{l}\n")).collect();
     std::fs::write(shards[0].join("results.jsonl"), cut).unwrap();
@@ -103,13 +103,13 @@ fn shards_merge_into_what_one_run_writes() {
         s(&shards[2]),
     ]);
     assert!(
-        !success && text.contains("--partial") && text.contains("shard0"),
+        !success && text.contains("--allow-partial") && text.contains("shard0"),
         "{text}"
     );
     let text = ok(&[
         "merge",
         "--force",
-        "--partial",
+        "--allow-partial",
         "--out",
         s(&merged),
         s(&shards[0]),
@@ -118,7 +118,13 @@ fn shards_merge_into_what_one_run_writes() {
     ]);
     assert!(text.contains("23 results"), "{text}");
     // an existing output is not overwritten without --force
-    let (success, text) = verti(&["merge", "--out", s(&merged), s(&shards[1])]);
+    let (success, text) = verti(&[
+        "merge",
+        "--allow-partial",
+        "--out",
+        s(&merged),
+        s(&shards[1]),
+    ]);
     assert!(!success && text.contains("--force"), "{text}");
 
     // shards of different runs do not merge

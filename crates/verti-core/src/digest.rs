@@ -74,6 +74,11 @@ impl Digest {
         self.u64(len)
     }
 
+    /// The digest of a file's bytes, as [`Digest::hex`].
+    pub fn of_file(path: &std::path::Path) -> std::io::Result<String> {
+        Ok(Digest::new().bytes(&std::fs::read(path)?).hex())
+    }
+
     /// The digest as 32 lowercase hex digits.
     pub fn hex(&self) -> String {
         format!("{:032x}", self.state)

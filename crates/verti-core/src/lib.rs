@@ -12,6 +12,7 @@
 
 pub mod digest;
 pub mod math;
+pub mod memory;
 pub mod messages;
 pub mod output;
 pub mod params;

@@ -9,6 +9,7 @@
 
 use crate::params::{ParamError, ParamSpec, ParamValue, Params, parse_assignment};
 use serde::Serialize;
+use std::path::PathBuf;
 use std::sync::Arc;
 
 /// Something built by a registry; `WHAT` names it in messages (`system`).
@@ -31,6 +32,26 @@ pub trait Factory<T: ?Sized + Registrable>: Send + Sync {
     /// present, in its declared type). Called once per use (e.g. once per trial), so a factory
     /// that loads something expensive (network weights) should load it once and share it.
     fn build(&self, params: &Params) -> Result<Box<T>, String>;
+    /// The files that what `build` makes reads when used with `params` on the worlds whose
+    /// indices are `worlds` (model cards, their weights): a run records them by content, so a
+    /// resume or merge with a changed file is refused. By default every non-empty path
+    /// parameter; a factory whose files name other files (a card and its weights) or whose
+    /// paths are templates lists them all.
+    fn inputs(&self, params: &Params, worlds: &[u32]) -> Result<Vec<PathBuf>, String> {
+        let _ = worlds;
+        Ok(path_params(params))
+    }
+}
+
+/// The non-empty path parameters of `params`, in declaration order.
+pub fn path_params(params: &Params) -> Vec<PathBuf> {
+    params
+        .iter()
+        .filter_map(|(_, v)| match v {
+            ParamValue::Path(p) if !p.as_os_str().is_empty() => Some(p.clone()),
+            _ => None,
+        })
+        .collect()
 }
 
 struct Entry<T: ?Sized + Registrable> {
@@ -168,6 +189,20 @@ impl<T: ?Sized + Registrable> Registry<T> {
         e.factory
             .build(params)
             .map_err(|why| ParamError(format!("cannot build {}: {why}", self.owner(name))))
+    }
+
+    /// The files the factory `name` reads with `params` on the worlds `worlds`
+    /// ([`Factory::inputs`]).
+    pub fn inputs(
+        &self,
+        name: &str,
+        params: &Params,
+        worlds: &[u32],
+    ) -> Result<Vec<PathBuf>, ParamError> {
+        let e = self.entry(name)?;
+        e.factory
+            .inputs(params, worlds)
+            .map_err(|why| ParamError(format!("{}: {why}", self.owner(name))))
     }
 
     /// [`Registry::resolve`] then [`Registry::build`].

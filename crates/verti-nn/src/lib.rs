@@ -14,6 +14,7 @@
 
 pub mod card;
 pub mod dense;
+pub mod files;
 pub mod layer;
 pub mod network;
 pub mod patch;

@@ -110,6 +110,9 @@ impl Factory<dyn MobilitySystem> for PietraSystem {
         }
     }
 
+    fn inputs(&self, p: &Params, _worlds: &[u32]) -> Result<Vec<std::path::PathBuf>, String> {
+        verti_nn::files::cards_in(p)
+    }
     fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
         let source = if p.bool("prior_only") {
             TravSource::Physics

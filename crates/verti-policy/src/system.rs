@@ -110,6 +110,9 @@ impl Factory<dyn MobilitySystem> for PolicySystem {
         }
     }
 
+    fn inputs(&self, p: &Params, _worlds: &[u32]) -> Result<Vec<std::path::PathBuf>, String> {
+        verti_nn::files::cards_in(p)
+    }
     fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
         let policy = match p.path("model") {
             Some(path) if path != Path::new("") => Arc::new(Policy::load(path)?),

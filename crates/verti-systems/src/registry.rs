@@ -150,9 +150,37 @@ pub fn mppi_among(owner: &str, p: &Params, step: Option<f64>) -> Result<MppiPara
         pairs.retain(|(n, _)| n != "step");
         pairs.push(("step".into(), ParamValue::Float(step)));
     }
-    Ok(mppi_from(
-        &Params::resolve(owner, specs, &pairs).map_err(|e| e.to_string())?,
-    ))
+    let m = mppi_from(&Params::resolve(owner, specs, &pairs).map_err(|e| e.to_string())?);
+    check_plan_memory(&m, verti_core::memory::usable_bytes())?;
+    Ok(m)
+}
+
+/// Memory one MPPI plan holds per sampled rollout step (noise, controls, poses, cost terms and
+/// the model's own buffers), bytes: measured as the growth of the peak resident size with
+/// `samples × horizon` (about 80 B for mppi and tal, 140 B for pietra), rounded up.
+pub const PLAN_BYTES_PER_STEP: u64 = 160;
+
+/// Refuses MPPI settings whose plan cannot fit: `samples × horizon` rollout steps at
+/// [`PLAN_BYTES_PER_STEP`] each must stay within a quarter of the memory this process may use
+/// (`usable`; unchecked when unknown), leaving room for a few jobs and the worlds. Without
+/// this, an allowed but huge combination aborted the process on allocation failure.
+pub fn check_plan_memory(m: &MppiParams, usable: Option<u64>) -> Result<(), String> {
+    let Some(usable) = usable else {
+        return Ok(());
+    };
+    let steps = (m.samples as u64).saturating_mul(m.horizon as u64);
+    let need = steps.saturating_mul(PLAN_BYTES_PER_STEP);
+    if need > usable / 4 {
+        let human = verti_core::memory::human;
+        return Err(format!(
+            "samples {} x horizon {} = {steps} rollout steps per plan need about {} per job, more than a quarter of the {} this process may use (the smaller of `ulimit -v` and the machine's memory): lower samples or horizon",
+            m.samples,
+            m.horizon,
+            human(need),
+            human(usable)
+        ));
+    }
+    Ok(())
 }
 
 /// [`MppiParams`] from parameters declared by [`mppi_params`] (cost weights, when not
@@ -218,7 +246,9 @@ impl Factory<dyn MobilitySystem> for MppiFactory {
         }
     }
     fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
-        Ok(Box::new(Mppi::new(mppi_from(p))))
+        let m = mppi_from(p);
+        check_plan_memory(&m, verti_core::memory::usable_bytes())?;
+        Ok(Box::new(Mppi::new(m)))
     }
 }
 
@@ -296,6 +326,24 @@ pub fn create(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_plan_that_cannot_fit_is_refused_with_its_size() {
+        let m = MppiParams {
+            samples: 65536,
+            horizon: 1000,
+            ..MppiParams::default()
+        };
+        // `ulimit -v 4000000` (KiB): the repro that aborted on allocation failure
+        let e = check_plan_memory(&m, Some(4_000_000 * 1024)).unwrap_err();
+        assert!(
+            e.contains("65536000 rollout steps") && e.contains("10.5 GB"),
+            "{e}"
+        );
+        // the defaults fit a small machine; nothing is checked where memory is unknown
+        assert!(check_plan_memory(&MppiParams::default(), Some(1 << 30)).is_ok());
+        assert!(check_plan_memory(&m, None).is_ok());
+    }
 
     #[test]
     fn builds_every_listed_system_and_rejects_bad_input() {

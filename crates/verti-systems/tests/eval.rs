@@ -57,6 +57,8 @@ fn setup<'a>(
             seed: 0,
             max_time: 30.0,
         },
+        inputs: None,
+        shard: None,
         step_log: None,
         cancel: None,
         warn: None,

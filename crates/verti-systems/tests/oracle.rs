@@ -131,6 +131,8 @@ fn results_do_not_depend_on_the_number_of_jobs() {
                 seed: 0,
                 max_time: 40.0,
             },
+            inputs: None,
+            shard: None,
             step_log: None,
             cancel: None,
             warn: None,

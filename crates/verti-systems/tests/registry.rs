@@ -166,6 +166,8 @@ fn setup<'a>(
             seed: 0,
             max_time: 5.0,
         },
+        inputs: None,
+        shard: None,
         step_log: None,
         cancel: None,
         warn: None,

@@ -280,6 +280,30 @@ impl Factory<dyn MobilitySystem> for VaSystem {
         }
     }
 
+    /// The given card, or with `model_per_world` each selected world's card (a card missing
+    /// for one of them is refused before the run, not met as an error trial in it).
+    fn inputs(&self, p: &Params, worlds: &[u32]) -> Result<Vec<std::path::PathBuf>, String> {
+        let mut files = verti_nn::files::cards_in(p)?;
+        let pattern = p.str("model_per_world");
+        if !pattern.is_empty() {
+            for world in worlds {
+                let card = pattern.replace("{world}", &format!("{world:03}"));
+                let card = Path::new(&card);
+                if !card.is_file() {
+                    return Err(format!(
+                        "model_per_world {pattern}: no card for world {world} ({} is missing)",
+                        card.display()
+                    ));
+                }
+                for f in verti_nn::files::card_files(card)? {
+                    if !files.contains(&f) {
+                        files.push(f);
+                    }
+                }
+            }
+        }
+        Ok(files)
+    }
     fn build(&self, p: &Params) -> Result<Box<dyn MobilitySystem>, String> {
         let given = p.path("model").filter(|path| *path != Path::new(""));
         let per_world = Some(p.str("model_per_world").to_string()).filter(|s| !s.is_empty());

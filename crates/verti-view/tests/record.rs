@@ -76,3 +76,34 @@ fn a_recording_samples_the_evaluated_trial() {
     assert_eq!(back.title, rec.title);
     assert!(!html.contains("/*VERTI_DATA*/"));
 }
+
+/// Names are the user's: `<!--<script>` in one put the HTML parser in the script-data escaped
+/// state, where one `</script>` no longer ends the data block, and the page broke (issue 33,
+/// item 10). No `<` may be left in the data block; the names still read back exactly.
+#[test]
+fn no_name_can_end_the_data_block_early() {
+    let set = verti_world::sets::resolve_set("verti-4", 1.0, &|| {}).unwrap();
+    let world = Arc::new(set.worlds.into_iter().next().unwrap());
+    let spec = verti_sim::vehicles::builtin("hmmwv").unwrap();
+    let cfg = EpisodeConfig {
+        max_time: 0.2,
+        ..Default::default()
+    };
+    let pair = world.tasks[0].pair;
+    let (mut rec, _) = verti_view::record_trial(&world, &spec, pair, &mut Steady, &cfg);
+    let hostile = "w <!--<script> </script> <!-- --> & \u{2028} \"x\" \\ end";
+    rec.title = hostile.to_string();
+    let html = verti_view::html(&rec);
+    let open = "<script id=\"data\" type=\"application/json\">";
+    let start = html.find(open).unwrap() + open.len();
+    let end = start + html[start..].find("</script>").unwrap();
+    let block = &html[start..end];
+    assert!(
+        !block.contains('<') && !block.contains('>'),
+        "the data block holds markup"
+    );
+    let back: verti_view::Recording = serde_json::from_str(block).unwrap();
+    assert_eq!(back.title, hostile);
+    // the page's own script follows the data block intact
+    assert!(html[end..].starts_with("</script>\n<script>\n\"use strict\";"));
+}

@@ -327,6 +327,9 @@ pub(super) fn evaluate(
     };
     // `evaluate` reads an empty selection as "all tasks"; nothing selected runs nothing
     let mut all = Vec::new();
+    let inputs = |tasks: &[(usize, u32)]| {
+        verti_bench::identity::system_inputs(&registry, system, &params, &worlds, tasks)
+    };
     if !numbers.is_empty() {
         let setup = EvalSetup {
             worlds: &worlds,
@@ -337,6 +340,8 @@ pub(super) fn evaluate(
             resume,
             force,
             run,
+            inputs: Some(&inputs),
+            shard: None,
             step_log: None,
             cancel: Some(&cancel),
             warn: Some(&note),
@@ -536,6 +541,9 @@ fn evaluate_object(
         resume: a.resume,
         force: a.force,
         run,
+        // a Python object: no files known to the registry
+        inputs: None,
+        shard: None,
         step_log: None,
         cancel: Some(&cancel),
         warn: Some(&note),
