@@ -5,7 +5,8 @@ use crate::eval_cmd::assignment;
 use crate::vehicle_cmd::load_vehicle;
 use crate::world_cmd::{CmdResult, ScaleArg, load_set_checked};
 use clap::Args;
-use std::path::PathBuf;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use verti_bench::EpisodeConfig;
 use verti_drive::script::KeyScript;
@@ -13,7 +14,7 @@ use verti_drive::server::{ServeOptions, serve};
 use verti_drive::{DemoInfo, DriveSession};
 use verti_world::World;
 
-/// Raised by Ctrl-C while the live view runs.
+/// Raised by Ctrl-C, SIGTERM or SIGHUP while the live view runs.
 static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 #[derive(Args)]
@@ -96,69 +97,43 @@ pub fn drive(a: DriveArgs) -> CmdResult {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("demos").join(format!("task-{}", a.task)));
-    // the dataset writer refuses a non-empty directory without --force: check before anyone
-    // drives, so no drive is lost to it at the end
-    let occupied = out.exists()
-        && std::fs::read_dir(&out)
-            .map_err(|e| format!("--out {}: {e}", out.display()))?
-            .next()
-            .is_some();
-    if occupied && !a.force {
-        return Err(format!(
-            "{} is not empty (a demonstration already there?): pass --force to replace it, or choose another --out",
-            out.display()
-        )
-        .into());
-    }
+    let script = match &a.keys {
+        Some(path) => {
+            let text =
+                std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            Some(KeyScript::parse(&text).map_err(|e| format!("{}: {e}", path.display()))?)
+        }
+        None => None,
+    };
     let cfg = EpisodeConfig {
         max_time: a.max_time,
         ..Default::default()
     };
-    let mut session = DriveSession::start(&world, &vehicle, id.pair, &cfg, system)?;
+    let session = DriveSession::start(&world, &vehicle, id.pair, &cfg, system)?;
     let rate = 1.0 / session.period();
-    let end = match &a.keys {
-        Some(path) => {
-            let text =
-                std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-            let script = KeyScript::parse(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-            script.drive(&mut session);
-            session.finish()
-        }
-        None => {
-            let listener = std::net::TcpListener::bind(("127.0.0.1", a.port))
-                .map_err(|e| format!("--port {}: cannot listen on 127.0.0.1: {e}", a.port))?;
-            let addr = listener.local_addr()?;
-            println!(
-                "live view: open http://{addr}/ in a browser ({}; Ctrl-C stops and saves)",
-                if a.system.is_some() {
-                    "watch the system drive"
-                } else {
-                    "drive with the arrow keys or WASD, space stops; a gamepad works too"
-                }
-            );
-            // Ctrl-C ends the session like the page's Stop button: what was driven is saved
-            extern "C" fn on_interrupt(_: libc::c_int) {
-                STOP.store(true, std::sync::atomic::Ordering::SeqCst);
-            }
-            // SAFETY: the handler only stores to an atomic, which is async-signal-safe
-            unsafe {
-                libc::signal(
-                    libc::SIGINT,
-                    on_interrupt as extern "C" fn(libc::c_int) as libc::sighandler_t,
-                );
-            }
-            let opts = ServeOptions {
-                speed: a.speed,
-                stop: Some(&STOP),
-                ..Default::default()
-            };
-            serve(session, &listener, opts)?
+    // check --out before anyone drives, so no drive is lost to it at the end
+    let created_out = prepare_out(&out, a.force)?;
+    let end = match run_session(session, script.as_ref(), &a) {
+        Ok(end) => end,
+        Err(e) => {
+            discard_out(&out, created_out);
+            return Err(e);
         }
     };
-    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty())
-        && !parent.exists()
-    {
-        std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
+    // no control period driven (the page was never opened, or stopped before its first
+    // poll): an empty demonstration is not data, and a dataset of no rows does not load
+    if end.record.rows.is_empty() {
+        discard_out(&out, created_out);
+        return Err(format!(
+            "nothing was recorded: the session ended before the trial was driven a single control period ({}), so no demonstration was written to {}",
+            if a.keys.is_some() {
+                "the key script drove no step"
+            } else {
+                "the live page never polled; open the address `verti drive` printed in a browser"
+            },
+            out.display()
+        )
+        .into());
     }
     let command: Vec<String> = std::env::args().collect();
     let info = DemoInfo {
@@ -175,7 +150,10 @@ pub fn drive(a: DriveArgs) -> CmdResult {
         .map_err(|e| format!("{}: {e}", result_path.display()))?;
     verti_view::write_html(&end.recording, &out.join("replay.html"))
         .map_err(|e| format!("{}: {e}", out.display()))?;
-    println!(
+    // after SIGHUP the terminal may be gone: a failed print must not turn a saved drive into
+    // a panic
+    let _ = writeln!(
+        std::io::stdout(),
         "task {} ({} pair {}): {} after {:.1} s, {:.1} m driven; demonstration in {} (dataset, result.json, replay.html)",
         a.task,
         world.meta.name,
@@ -186,4 +164,89 @@ pub fn drive(a: DriveArgs) -> CmdResult {
         out.display()
     );
     Ok(())
+}
+
+/// Drives `session` headless with `script`, or serves the live view until it ends.
+fn run_session(
+    mut session: DriveSession,
+    script: Option<&KeyScript>,
+    a: &DriveArgs,
+) -> Result<verti_drive::SessionEnd, Box<dyn std::error::Error>> {
+    if let Some(script) = script {
+        script.drive(&mut session);
+        return Ok(session.finish());
+    }
+    let listener = std::net::TcpListener::bind(("127.0.0.1", a.port))
+        .map_err(|e| format!("--port {}: cannot listen on 127.0.0.1: {e}", a.port))?;
+    let addr = listener.local_addr()?;
+    // Ctrl-C, SIGTERM (a supervisor, `kill`) and SIGHUP (the terminal closed) end the session
+    // like the page's Stop button: what was driven is saved. Installed before the address is
+    // printed, so whoever reads it can already stop the session.
+    extern "C" fn on_signal(_: libc::c_int) {
+        STOP.store(true, std::sync::atomic::Ordering::SeqCst);
+    }
+    for signal in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+        // SAFETY: the handler only stores to an atomic, which is async-signal-safe
+        unsafe {
+            libc::signal(
+                signal,
+                on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
+            );
+        }
+    }
+    println!(
+        "live view: open http://{addr}/ in a browser ({}; Ctrl-C stops and saves)",
+        if a.system.is_some() {
+            "watch the system drive"
+        } else {
+            "drive with the arrow keys or WASD, space stops; a gamepad works too"
+        }
+    );
+    let opts = ServeOptions {
+        speed: a.speed,
+        stop: Some(&STOP),
+        ..Default::default()
+    };
+    Ok(serve(session, &listener, opts)?)
+}
+
+/// Removes `out` again if it was created for this drive and nothing went in.
+fn discard_out(out: &Path, created: bool) {
+    if created {
+        // remove_dir refuses a directory that is not empty
+        let _ = std::fs::remove_dir(out);
+    }
+}
+
+/// Makes sure a demonstration can be written to `out` before anyone drives: the directory
+/// exists (created here, with its parents), is empty unless `force`, and takes a file.
+/// Returns whether it was created here (and so may be removed if nothing is recorded).
+fn prepare_out(out: &Path, force: bool) -> Result<bool, String> {
+    let fail = |what: &str, e: std::io::Error| {
+        format!(
+            "--out {}: {what} ({e}); choose a writable directory",
+            out.display()
+        )
+    };
+    let created = !out.exists();
+    std::fs::create_dir_all(out).map_err(|e| fail("cannot create the directory", e))?;
+    // the dataset writer refuses a non-empty directory without --force
+    let occupied = std::fs::read_dir(out)
+        .map_err(|e| fail("cannot read the directory", e))?
+        .next()
+        .is_some();
+    if occupied && !force {
+        return Err(format!(
+            "{} is not empty (a demonstration already there?): pass --force to replace it, or choose another --out",
+            out.display()
+        ));
+    }
+    let probe = out.join(format!(".verti-write-probe-{}", std::process::id()));
+    let written = std::fs::File::create(&probe).and_then(|mut f| {
+        f.write_all(b"probe")?;
+        f.sync_all()
+    });
+    let _ = std::fs::remove_file(&probe);
+    written.map_err(|e| fail("cannot write there", e))?;
+    Ok(created)
 }

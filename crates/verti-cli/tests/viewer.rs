@@ -171,10 +171,21 @@ fn live_session(browser: &Path, system: Option<&str>, hash: &str, name: &str) ->
     // stop the session the way the page's button does (unless the trial ended first and the
     // server, its end seen by the page, has already saved and gone)
     let addr = url.trim_start_matches("http://").trim_end_matches('/');
-    if let Ok(mut s) = std::net::TcpStream::connect(addr) {
-        write!(s, "GET /quit HTTP/1.1\r\nHost: x\r\n\r\n").unwrap();
+    let request = |text: String| {
+        let mut s = std::net::TcpStream::connect(addr).ok()?;
+        s.write_all(text.as_bytes()).ok()?;
         let mut reply = String::new();
         let _ = s.read_to_string(&mut reply);
+        Some(reply)
+    };
+    // the page carries the session's token; `/quit` wants it, by POST, addressed to the server
+    let page = request(format!(
+        "GET / HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n"
+    ));
+    if let Some(token) = page.as_deref().and_then(verti_drive::server::token_in_page) {
+        request(format!(
+            "POST /quit HTTP/1.1\r\nHost: {addr}\r\nX-Verti-Token: {token}\r\nContent-Length: 0\r\nConnection: close\r\n\r\n"
+        ));
     }
     assert!(child.wait().unwrap().success());
     let rest: Vec<String> = lines.map_while(Result::ok).collect();

@@ -3,7 +3,7 @@
 use crate::generate::{GenerateConfig, Source, generate};
 use crate::manifest::{FORMAT, MANIFEST, Manifest, WorldsInfo, checksum};
 use crate::table::{Table, TrialRecord, write_table};
-use crate::{DataError, Result};
+use crate::{DataError, Kind, Result};
 use std::path::Path;
 use verti_world::WorldSource;
 
@@ -136,6 +136,24 @@ pub fn write_dataset(
         progress,
     )?;
     flush(&mut pending, &mut files)?;
+    // a dataset with no trial is no data (its reader refuses it): say so instead of writing it
+    if totals.trials == 0 || totals.rows == 0 {
+        let outcomes: Vec<String> = totals
+            .outcomes
+            .iter()
+            .map(|(k, v)| format!("{k} {v}"))
+            .collect();
+        return Err(DataError::Run(format!(
+            "{}: no trial was kept from {:.2} h of simulated driving (outcomes: {}), so no dataset was written{}",
+            dir.display(),
+            totals.seconds_simulated / 3600.0,
+            if outcomes.is_empty() { "none".to_string() } else { outcomes.join(", ") },
+            match cfg.kind {
+                Kind::Expert => "; an expert dataset keeps successful trials only: use a stronger system, a longer --max-trial-seconds or more worlds",
+                _ => "",
+            }
+        )));
+    }
     let first = &cfg.worlds[0].meta;
     let (seed, generator) = match &first.source {
         WorldSource::Generated {

@@ -12,9 +12,13 @@
 //!   replaying a person's inputs headless.
 //! * [`server`]: a small local web server: the browser shows the 3-D view (the same page as
 //!   `verti replay --3d`, in live mode) and sends the keys it holds; the server steps the trial
-//!   in real time and streams the new frames back.
+//!   in real time and streams the new frames back; [`http`] parses its requests and
+//!   [`access`] decides who may send them (loopback names only, same origin, a session
+//!   token).
 
+pub mod access;
 pub mod driver;
+pub mod http;
 pub mod script;
 pub mod server;
 pub mod session;

@@ -1,29 +1,13 @@
 //! Driving headless: scripted keys through a session, and the live view's server driven by a
 //! scripted HTTP client the way the page drives it.
 
-use std::io::{Read, Write};
-use std::net::{TcpListener, TcpStream};
-use std::sync::Arc;
+mod common;
+
+use common::{Server, world};
 use std::time::Duration;
 use verti_bench::EpisodeConfig;
 use verti_drive::script::KeyScript;
-use verti_drive::server::{ServeOptions, serve};
 use verti_drive::{DemoInfo, DriveSession};
-
-fn world() -> (Vec<Arc<verti_world::World>>, verti_sim::VehicleSpec) {
-    let set = verti_world::sets::resolve_set("verti-4", 1.0, &|| {}).unwrap();
-    let worlds = set.worlds.into_iter().map(Arc::new).collect();
-    (worlds, verti_sim::vehicles::builtin("hmmwv").unwrap())
-}
-
-fn get(addr: std::net::SocketAddr, path: &str) -> String {
-    let mut s = TcpStream::connect(addr).unwrap();
-    write!(s, "GET {path} HTTP/1.1\r\nHost: x\r\n\r\n").unwrap();
-    let mut text = String::new();
-    s.read_to_string(&mut text).unwrap();
-    let (_, body) = text.split_once("\r\n\r\n").unwrap();
-    body.to_string()
-}
 
 #[test]
 fn a_scripted_drive_follows_the_rules_and_records_a_dataset() {
@@ -83,23 +67,8 @@ fn a_scripted_drive_follows_the_rules_and_records_a_dataset() {
 
 #[test]
 fn the_live_server_steps_in_time_with_the_keys_it_is_sent() {
-    let (worlds, spec) = world();
-    let w = worlds[0].clone();
-    let listener = TcpListener::bind(("127.0.0.1", 0)).unwrap();
-    let addr = listener.local_addr().unwrap();
-    let server = std::thread::spawn(move || {
-        let cfg = EpisodeConfig::default();
-        let session = DriveSession::start(&w, &spec, w.tasks[0].pair, &cfg, None).unwrap();
-        // 20x real time keeps the test short
-        let opts = ServeOptions {
-            speed: 20.0,
-            idle: Duration::from_secs(10),
-            stop: None,
-        };
-        serve(session, &listener, opts).unwrap()
-    });
-    let page = get(addr, "/");
-    assert!(page.contains("\"live\":true") && page.contains("<canvas"));
+    // 20x real time keeps the test short
+    let server = Server::start(20.0, Duration::from_secs(10));
     let mut frames = 1usize;
     let mut top_speed = 0.0f64;
     // poll until the goal of the test is reached rather than a fixed number of times: the
@@ -109,7 +78,7 @@ fn the_live_server_steps_in_time_with_the_keys_it_is_sent() {
         if frames > 50 && top_speed > 4.0 {
             break;
         }
-        let body = get(addr, &format!("/step?keys=u&since={frames}"));
+        let body = server.post(&format!("/step?keys=u&since={frames}")).body;
         let j: serde_json::Value = serde_json::from_str(&body).unwrap();
         let new = j["frames"].as_array().unwrap();
         frames += new.len();
@@ -122,9 +91,24 @@ fn the_live_server_steps_in_time_with_the_keys_it_is_sent() {
     // top target speed (5 m/s)
     assert!(frames > 50, "{frames}");
     assert!(top_speed > 4.0, "{top_speed}");
-    assert!(get(addr, "/step?keys=x").contains("unknown key `x`"));
-    assert_eq!(get(addr, "/quit"), "stopped");
-    let end = server.join().unwrap();
+    let bad = server.post("/step?keys=x");
+    assert_eq!(bad.status, 400);
+    assert!(bad.body.contains("unknown key `x`"), "{}", bad.body);
+    // keys in a form body work as well as in the query
+    let body = format!("keys=u&since={frames}");
+    let form = common::exchange(
+        server.addr,
+        &format!(
+            "POST /step HTTP/1.1\r\nHost: {}\r\nX-Verti-Token: {}\r\nContent-Type: application/x-www-form-urlencoded\r\nContent-Length: {}\r\n\r\n{body}",
+            server.host,
+            server.token,
+            body.len()
+        ),
+    );
+    assert_eq!(form.status, 200, "{}", form.body);
+    let j: serde_json::Value = serde_json::from_str(&form.body).unwrap();
+    frames += j["frames"].as_array().unwrap().len();
+    let end = server.quit();
     // stopped while running: kept, as a trial that did not end
     assert_eq!(end.recording.frames.len(), frames);
     assert_eq!(end.record.rows.len(), frames - 1);
