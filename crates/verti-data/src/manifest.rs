@@ -182,8 +182,25 @@ impl Manifest {
                 format!("format `{}` is not {FORMAT}", m.format),
             ));
         }
-        if !(m.rate.is_finite() && m.rate > 0.0) || m.wheels == 0 {
-            return Err(DataError::file(&path, "bad rate or wheel count"));
+        if !(m.rate.is_finite() && m.rate > 0.0) {
+            return Err(DataError::file(
+                &path,
+                format!(
+                    "field rate: {} must be a positive number of rows per second",
+                    m.rate
+                ),
+            ));
+        }
+        // the reader names 3 columns per wheel: a damaged count must not make it name billions
+        let most = verti_sim::spec::MAX_WHEELS;
+        if !(1..=most).contains(&m.wheels) {
+            return Err(DataError::file(
+                &path,
+                format!(
+                    "field wheels: {} is not the wheel count of a vehicle (1 to {most})",
+                    m.wheels
+                ),
+            ));
         }
         Ok(m)
     }

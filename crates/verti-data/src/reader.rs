@@ -2,7 +2,7 @@
 //! trials as row ranges.
 
 use crate::manifest::{DataOutcome, Manifest};
-use crate::table::{Table, read_table, schema};
+use crate::table::{Table, read_table_at_most, schema};
 use crate::{DataError, Result};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -81,7 +81,8 @@ impl Dataset {
                     ));
                 }
             }
-            table.append(read_table(&path, &expected)?);
+            let left = manifest.rows.saturating_sub(table.rows());
+            table.append(read_table_at_most(&path, &expected, left)?);
         }
         let manifest_path = dir.join(crate::manifest::MANIFEST);
         if table.rows() != manifest.rows {

@@ -147,9 +147,14 @@ pub fn write_dataset(
             "{}: no trial was kept from {:.2} h of simulated driving (outcomes: {}), so no dataset was written{}",
             dir.display(),
             totals.seconds_simulated / 3600.0,
-            if outcomes.is_empty() { "none".to_string() } else { outcomes.join(", ") },
+            if outcomes.is_empty() {
+                "none".to_string()
+            } else {
+                outcomes.join(", ")
+            },
             match cfg.kind {
-                Kind::Expert => "; an expert dataset keeps successful trials only: use a stronger system, a longer --max-trial-seconds or more worlds",
+                Kind::Expert =>
+                    "; an expert dataset keeps successful trials only: use a stronger system, a longer --max-trial-seconds or more worlds",
                 _ => "",
             }
         )));

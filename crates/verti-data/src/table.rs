@@ -325,8 +325,49 @@ pub fn write_table(path: &Path, table: &Table) -> Result<()> {
 /// Reads a table written by [`write_table`], checking its columns against `expected` (names
 /// and types, in order). Any damage (truncation, a bad footer or page) is an error naming the file.
 pub fn read_table(path: &Path, expected: &[(String, &'static str)]) -> Result<Table> {
-    let err = |e: parquet::errors::ParquetError| DataError::file(path, e);
+    read_table_at_most(path, expected, usize::MAX)
+}
+
+/// [`read_table`] of a file that may hold at most `max_rows` rows (what its manifest leaves
+/// for it): a footer claiming more is refused before any column is read, so that a damaged row
+/// count cannot size the reader's buffers.
+pub fn read_table_at_most(
+    path: &Path,
+    expected: &[(String, &'static str)],
+    max_rows: usize,
+) -> Result<Table> {
     let file = std::fs::File::open(path).map_err(|e| DataError::file(path, e))?;
+    // The parquet crate panics on some damaged files instead of returning an error (a
+    // dictionary index past the dictionary in `rle.rs`, a negative offset or a bad thrift
+    // field in the footer). Parquet pages carry no checksum to check first, and a manifest's
+    // checksum may be absent (hand-made data) or rewritten with the file, so the decoder's
+    // panic is caught here and reported as damage to this file. The decoding touches only
+    // its own reader and the table it builds, both dropped on a panic, so nothing broken is
+    // observed afterwards (hence `AssertUnwindSafe`). The panic message is still printed by
+    // the process's panic hook: silencing it would need a process-wide hook.
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        decode_table(path, file, expected, max_rows)
+    }))
+    .unwrap_or_else(|panic| {
+        let what = panic
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "the decoder failed".to_string());
+        Err(DataError::file(
+            path,
+            format!("damaged Parquet data ({what})"),
+        ))
+    })
+}
+
+fn decode_table(
+    path: &Path,
+    file: std::fs::File,
+    expected: &[(String, &'static str)],
+    max_rows: usize,
+) -> Result<Table> {
+    let err = |e: parquet::errors::ParquetError| DataError::file(path, e);
     let reader = SerializedFileReader::new(file).map_err(err)?;
     let meta = reader.metadata();
     let fields = meta.file_metadata().schema_descr().columns().to_vec();
@@ -348,9 +389,26 @@ pub fn read_table(path: &Path, expected: &[(String, &'static str)]) -> Result<Ta
         ));
     }
     let mut table = Table::default();
+    let mut rows: usize = 0;
     for g in 0..meta.num_row_groups() {
         let rg = reader.get_row_group(g).map_err(err)?;
-        let n = usize::try_from(rg.metadata().num_rows()).unwrap_or(0);
+        let claimed = rg.metadata().num_rows();
+        let n = usize::try_from(claimed).map_err(|_| {
+            DataError::file(
+                path,
+                format!("row group {g} claims {claimed} rows (a damaged footer)"),
+            )
+        })?;
+        if rows.checked_add(n).is_none_or(|r| r > max_rows) {
+            return Err(DataError::file(
+                path,
+                format!(
+                    "row group {g} claims {claimed} rows, more than the {} the manifest leaves for this file (the file or the manifest is damaged, or the file was replaced)",
+                    max_rows - rows
+                ),
+            ));
+        }
+        rows += n;
         let mut part = Table::default();
         for (c, (name, ty)) in expected.iter().enumerate() {
             let col = read_column(rg.get_column_reader(c).map_err(err)?, n).map_err(err)?;
@@ -376,10 +434,14 @@ pub fn read_table(path: &Path, expected: &[(String, &'static str)]) -> Result<Ta
 
 /// Reads `n` records of one column chunk (None for a type the schema never uses).
 fn read_column(reader: ColumnReader, n: usize) -> parquet::errors::Result<Option<Column>> {
+    // `n` comes from the file's footer: reserve for at most a modest number of rows up front
+    // (the vectors grow as values are read), so that a damaged count cannot ask for more
+    // memory than exists
+    let reserve = n.min(1 << 16);
     // read_records may stop at a page boundary; loop until the chunk is exhausted
     macro_rules! read_all {
         ($r:expr, $def:expr) => {{
-            let mut values = Vec::with_capacity(n);
+            let mut values = Vec::with_capacity(reserve);
             let mut got = 0;
             while got < n {
                 let (records, _, _) = $r.read_records(n - got, $def, None, &mut values)?;
@@ -396,7 +458,7 @@ fn read_column(reader: ColumnReader, n: usize) -> parquet::errors::Result<Option
         ColumnReader::DoubleColumnReader(mut r) => Column::F64(read_all!(r, None)),
         ColumnReader::BoolColumnReader(mut r) => Column::Bool(read_all!(r, None)),
         ColumnReader::ByteArrayColumnReader(mut r) => {
-            let mut def: Vec<i16> = Vec::with_capacity(n);
+            let mut def: Vec<i16> = Vec::with_capacity(reserve);
             let values: Vec<ByteArray> = read_all!(r, Some(&mut def));
             let mut values = values.into_iter();
             let mut out = Vec::with_capacity(def.len());

@@ -60,10 +60,18 @@ pub enum Shape {
 }
 
 impl Shape {
+    /// Number of values. Saturates at `usize::MAX` (a length no input can have) for a shape
+    /// whose product overflows; a loaded [`crate::Network`] has none, since every shape of
+    /// a card is checked with [`Shape::checked_len`].
     pub fn len(self) -> usize {
+        self.checked_len().unwrap_or(usize::MAX)
+    }
+    /// Number of values, or None when the product overflows `usize` (a damaged or crafted
+    /// card: the sizes come from the file).
+    pub fn checked_len(self) -> Option<usize> {
         match self {
-            Shape::Flat(n) => n,
-            Shape::Image([c, h, w]) => c * h * w,
+            Shape::Flat(n) => Some(n),
+            Shape::Image([c, h, w]) => c.checked_mul(h)?.checked_mul(w),
         }
     }
     pub fn is_empty(self) -> bool {
@@ -95,10 +103,20 @@ impl LayerSpec {
         }
     }
 
-    /// Number of parameters (weights, then biases).
+    /// Number of parameters (weights, then biases). Saturates at `usize::MAX` (a count no
+    /// weight file matches) for sizes whose product overflows; a loaded [`crate::Network`]
+    /// has none, since its card is checked with [`LayerSpec::checked_parameter_count`].
     pub fn parameter_count(&self) -> usize {
+        self.checked_parameter_count().unwrap_or(usize::MAX)
+    }
+
+    /// Number of parameters, or None when it overflows `usize`: the sizes come from a file,
+    /// and a wrapped count could match a small weight file and pass its size and digest checks.
+    pub fn checked_parameter_count(&self) -> Option<usize> {
         match *self {
-            LayerSpec::Linear { inputs, outputs } => inputs * outputs + outputs,
+            LayerSpec::Linear { inputs, outputs } => {
+                inputs.checked_mul(outputs)?.checked_add(outputs)
+            }
             LayerSpec::Conv2d {
                 in_channels: i,
                 out_channels: o,
@@ -110,8 +128,26 @@ impl LayerSpec {
                 out_channels: o,
                 kernel: k,
                 ..
-            } => i * o * k * k + o,
-            _ => 0,
+            } => i
+                .checked_mul(o)?
+                .checked_mul(k)?
+                .checked_mul(k)?
+                .checked_add(o),
+            _ => Some(0),
+        }
+    }
+
+    /// Values of the largest buffer [`LayerSpec::forward`] allocates besides its output (the
+    /// column phases of a strided convolution), or None when that overflows `usize`. With a
+    /// large stride it can be far bigger than the input, so a card's strides are bounded
+    /// through it.
+    pub fn scratch_len(&self, input: Shape) -> Option<usize> {
+        match (self, input) {
+            (&LayerSpec::Conv2d { stride, .. }, Shape::Image([c, h, w])) if stride > 0 => c
+                .checked_mul(h)?
+                .checked_mul(stride)?
+                .checked_mul(w.div_ceil(stride)),
+            _ => Some(0),
         }
     }
 
@@ -137,17 +173,17 @@ impl LayerSpec {
                 if c != in_channels {
                     return Err(format!("conv2d takes {in_channels} channels, got {input}"));
                 }
-                if stride == 0
-                    || kernel == 0
-                    || h + 2 * padding < kernel
-                    || w + 2 * padding < kernel
-                {
-                    return Err(format!(
+                // checked: every size comes from the file
+                let side = |n: usize| {
+                    let padded = padding.checked_mul(2)?.checked_add(n)?;
+                    Some(padded.checked_sub(kernel)?.checked_div(stride)? + 1)
+                };
+                match (side(h), side(w)) {
+                    (Some(oh), Some(ow)) if kernel > 0 => Ok(Shape::Image([out_channels, oh, ow])),
+                    _ => Err(format!(
                         "conv2d kernel {kernel} stride {stride} padding {padding} does not fit {input}"
-                    ));
+                    )),
                 }
-                let side = |n: usize| (n + 2 * padding - kernel) / stride + 1;
-                Ok(Shape::Image([out_channels, side(h), side(w)]))
             }
             LayerSpec::ConvTranspose2d {
                 in_channels,
@@ -163,11 +199,16 @@ impl LayerSpec {
                         "conv_transpose2d takes {in_channels} channels, got {input}"
                     ));
                 }
+                // checked: every size comes from the file (and a side of 0 has no n - 1)
                 let side = |n: usize| {
-                    ((n - 1) * stride + kernel + output_padding).checked_sub(2 * padding)
+                    n.checked_sub(1)?
+                        .checked_mul(stride)?
+                        .checked_add(kernel)?
+                        .checked_add(output_padding)?
+                        .checked_sub(padding.checked_mul(2)?)
                 };
-                match (stride, side(h), side(w)) {
-                    (1.., Some(oh @ 1..), Some(ow @ 1..)) if h > 0 && w > 0 => {
+                match (stride, kernel, side(h), side(w)) {
+                    (1.., 1.., Some(oh @ 1..), Some(ow @ 1..)) => {
                         Ok(Shape::Image([out_channels, oh, ow]))
                     }
                     _ => Err(format!(
@@ -175,16 +216,21 @@ impl LayerSpec {
                     )),
                 }
             }
+            LayerSpec::LeakyRelu { slope } if !slope.is_finite() => {
+                Err(format!("leaky_relu slope {slope} is not finite"))
+            }
             LayerSpec::Relu | LayerSpec::LeakyRelu { .. } | LayerSpec::Tanh => Ok(input),
             LayerSpec::Reshape { shape } => {
                 let out = Shape::Image(shape);
-                if out.len() == input.len() {
-                    Ok(out)
-                } else {
-                    Err(format!("cannot reshape {input} to {out}"))
+                match (out.checked_len(), input.checked_len()) {
+                    (Some(a), Some(b)) if a == b => Ok(out),
+                    _ => Err(format!("cannot reshape {input} to {out}")),
                 }
             }
-            LayerSpec::Flatten => Ok(Shape::Flat(input.len())),
+            LayerSpec::Flatten => input
+                .checked_len()
+                .map(Shape::Flat)
+                .ok_or_else(|| format!("cannot flatten {input}: its length overflows")),
         }
     }
 

@@ -44,15 +44,35 @@ impl Network {
                 card.format
             )));
         }
+        // Every size below comes from the file: arithmetic on them is checked, and every
+        // activation is bounded, so that a loaded network runs without overflow or an
+        // allocation that cannot succeed (a wrapped count could match a small weight file).
+        check_size(card.input.checked_len(), "the input", card.input)
+            .map_err(|e| bad(format!("field input: {e}")))?;
         let mut layout = Vec::with_capacity(card.layers.len());
         let mut shape = card.input;
-        let mut offset = 0;
+        let mut offset: usize = 0;
         for (i, layer) in card.layers.iter().enumerate() {
+            let field = |e: String| bad(format!("field layers[{i}]: {e}"));
             layout.push((offset, shape));
-            offset += layer.parameter_count();
-            shape = layer
-                .output_shape(shape)
-                .map_err(|e| bad(format!("field layers[{i}]: {e}")))?;
+            offset = layer
+                .checked_parameter_count()
+                .and_then(|n| offset.checked_add(n))
+                .ok_or_else(|| {
+                    field(format!(
+                        "the parameter count overflows at this {} layer (sizes too large)",
+                        layer.kind()
+                    ))
+                })?;
+            let scratch = layer.scratch_len(shape);
+            if scratch.is_none_or(|n| n > MAX_VALUES) {
+                return Err(field(format!(
+                    "the {} layer on {shape} needs a work buffer of more than {MAX_VALUES} values (stride too large)",
+                    layer.kind()
+                )));
+            }
+            shape = layer.output_shape(shape).map_err(field)?;
+            check_size(shape.checked_len(), "the output", shape).map_err(field)?;
         }
         if offset != card.weights.floats {
             return Err(bad(format!(
@@ -60,13 +80,13 @@ impl Network {
                 card.weights.floats
             )));
         }
-        if weights.len() != 4 * offset {
+        if offset.checked_mul(4) != Some(weights.len()) {
             return Err(bad(format!(
-                "weights file {} has {} bytes, expected {} ({} f32 values): truncated or not this model's",
+                "weights file {} has {} bytes, expected {} ({offset} f32 values): truncated or not this model's",
                 card.weights.file,
                 weights.len(),
-                4 * offset,
-                offset
+                // in u128: a count from the card may be near usize::MAX
+                4 * offset as u128,
             )));
         }
         let digest = format!("{:016x}", fnv1a64(weights));
@@ -208,6 +228,23 @@ impl Network {
             self.params.len(),
             self.weight_bytes() as f64 / 1024.0
         )
+    }
+}
+
+/// Most values one activation (a layer's input or output, or a work buffer) may hold: 2^28
+/// f32 values, 1 GiB. The shipped models stay below 2^19; the bound refuses cards whose sizes
+/// would make [`Network::forward`] allocate without limit.
+pub const MAX_VALUES: usize = 1 << 28;
+
+/// Checks the length of `shape` (`len`: None when it overflows): not empty, not above
+/// [`MAX_VALUES`].
+fn check_size(len: Option<usize>, what: &str, shape: Shape) -> Result<(), String> {
+    match len {
+        Some(1..=MAX_VALUES) => Ok(()),
+        Some(0) => Err(format!("{what} {shape} is empty")),
+        _ => Err(format!(
+            "{what} {shape} has more than {MAX_VALUES} values (sizes too large)"
+        )),
     }
 }
 

@@ -13,6 +13,10 @@ use std::path::Path;
 /// Most wheels (or road wheels) a vehicle may have; keeps per-step work bounded.
 pub const MAX_WHEELS: usize = 16;
 
+/// Largest torque \[N m\] a powertrain map may give: the built-in vehicles stay below 2000,
+/// the largest mining trucks below 1e5.
+pub const MAX_ENGINE_TORQUE: f64 = 1e7;
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VehicleSpec {
@@ -582,6 +586,18 @@ impl VehicleSpec {
             for (k, pt) in map.iter().enumerate() {
                 finite(&format!("powertrain.{name}[{k}][0]"), pt[0])?;
                 finite(&format!("powertrain.{name}[{k}][1]"), pt[1])?;
+                // finite is not enough: a torque near f64::MAX overflows to infinity once
+                // multiplied through the drivetrain, and the simulator meets inf - inf = NaN
+                // inside a step (found by tests/fuzz_vehicle.rs with 1e308)
+                if pt[1].abs() > MAX_ENGINE_TORQUE {
+                    return Err(bad(
+                        format!("powertrain.{name}[{k}][1]"),
+                        format!(
+                            "torque {} N m is beyond ±{MAX_ENGINE_TORQUE:e} N m, far more than any engine",
+                            pt[1]
+                        ),
+                    ));
+                }
                 if k > 0 && pt[0] <= map[k - 1][0] {
                     return Err(bad(
                         format!("powertrain.{name}[{k}]"),
