@@ -106,6 +106,7 @@ pub fn compare(a: CompareArgs) -> CmdResult {
     let refs: Vec<&RefTask> = chosen.iter().map(|&i| &reference.tasks[i]).collect();
     let worlds = load_worlds(
         &a.vb_worlds,
+        &a.reference,
         &refs.iter().map(|t| &t.outcome).collect::<Vec<_>>(),
         &setup,
     )?;

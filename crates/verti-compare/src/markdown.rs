@@ -41,10 +41,10 @@ fn counts(c: &OutcomeCounts) -> String {
 }
 
 fn group_name(a: &Aggregate) -> String {
-    if a.group == "all" {
-        "all tasks".into()
-    } else {
-        format!("{} elevation", a.group)
+    match a.group.as_str() {
+        "all" => "all tasks".into(),
+        level @ ("low" | "mid" | "high") => format!("{level} elevation"),
+        ground => format!("on {ground}"),
     }
 }
 
@@ -63,7 +63,7 @@ pub fn markdown(s: &Summary) -> String {
     };
     let _ = writeln!(
         out,
-        "# verti vs {r} ({})\n\nverti: {} driven by {driver} (speed {} m/s, lookahead {} m{gain}, rate {} Hz, inner step {} ms), {} start, {rules} rules, {} s, every patch {} with friction {}. Ratios are verti / {r}; the attitude ratios of the first table are medians of the per-task ratios.\n",
+        "# verti vs {r} ({})\n\nverti: {} driven by {driver} (speed {} m/s, lookahead {} m{gain}, rate {} Hz, inner step {} ms), {} start, {rules} rules, {} s, {}. Ratios are verti / {r}; the attitude ratios of the first table are medians of the per-task ratios.\n",
         s.engine,
         st.vehicle,
         st.speed,
@@ -72,8 +72,7 @@ pub fn markdown(s: &Summary) -> String {
         1000.0 * st.inner_dt,
         st.start.name(),
         st.max_time,
-        st.surface,
-        st.friction
+        ground_text(s)
     );
     let _ = writeln!(
         out,
@@ -264,6 +263,32 @@ fn per_task(out: &mut String, r: &str, tasks: &[TaskComparison]) {
             num(t.whole.mean_roll_error, 1),
         );
     }
+}
+
+/// How the compared worlds were prepared, by the grounds their tasks were run on.
+fn ground_text(s: &Summary) -> String {
+    let st = &s.setup;
+    let mut parts = Vec::new();
+    let mut soils = Vec::new();
+    for g in &s.grounds {
+        match g.as_str() {
+            "one-friction" => parts.push(format!(
+                "every patch {} with friction {}",
+                st.surface, st.friction
+            )),
+            "rigid-sections" => parts.push(
+                "rigid ground with each patch's friction that of its reference section".into(),
+            ),
+            soil => soils.push(soil.to_string()),
+        }
+    }
+    if !soils.is_empty() {
+        parts.push(format!(
+            "the {} worlds as imported (one soil each, over the whole map)",
+            soils.join(", ")
+        ));
+    }
+    parts.join("; ")
 }
 
 #[cfg(test)]

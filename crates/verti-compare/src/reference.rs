@@ -21,6 +21,47 @@ pub fn trajectory_file_name(world_index: u32, pair: u32) -> String {
     format!("world-{world_index:03}_p{pair}.csv")
 }
 
+/// The ground a reference task was run on (the outcome line's `soil` field).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RefGround {
+    /// No `soil` field: rigid ground with one friction everywhere (the first reference set).
+    OneFriction,
+    /// `snow`, `mud` or `sand`: one SCM soil over the whole map, the world's own (the
+    /// single-soil deformable worlds, compared as imported).
+    Soil(verti_world::TerrainClass),
+    /// `rigid-sections`: rigid ground built from the reference's friction sections
+    /// (`frictions/world-NNN.tsv` in the reference folder).
+    Sections,
+}
+
+impl RefGround {
+    /// The name in outcome lines and summaries.
+    pub fn name(self) -> String {
+        match self {
+            RefGround::OneFriction => "one-friction".into(),
+            RefGround::Soil(class) => class.to_string(),
+            RefGround::Sections => "rigid-sections".into(),
+        }
+    }
+
+    fn parse(text: Option<&str>) -> Result<RefGround, String> {
+        use verti_world::TerrainClass;
+        Ok(match text {
+            None => RefGround::OneFriction,
+            Some("rigid-sections") => RefGround::Sections,
+            Some("snow") => RefGround::Soil(TerrainClass::Snow),
+            Some("mud") => RefGround::Soil(TerrainClass::Mud),
+            Some("sand") => RefGround::Soil(TerrainClass::Sand),
+            Some(other) => {
+                return Err(format!(
+                    "field `soil`: `{other}` is not one of snow, mud, sand, rigid-sections"
+                ));
+            }
+        })
+    }
+}
+
 /// One line of `outcomes.jsonl`: how the reference engine's trial of one task ended.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RefOutcome {
@@ -44,6 +85,8 @@ pub struct RefOutcome {
     pub path_length: Option<f64>,
     /// Real-time factor of the reference engine (simulated / wall seconds).
     pub rtf: Option<f64>,
+    /// The ground the task was run on.
+    pub ground: RefGround,
     /// Line of the outcomes file (1-based), for messages.
     pub line: usize,
 }
@@ -231,6 +274,7 @@ fn parse_outcome(obj: &Map<String, Value>, line: usize) -> Result<RefOutcome, St
         final_roll: number("final_roll")?,
         path_length: number("path_length")?,
         rtf: number("rtf")?,
+        ground: RefGround::parse(text("soil")?.as_deref())?,
         line,
     };
     if o.time < 0.0 {

@@ -9,7 +9,7 @@
 
 use crate::driver::ReferenceDriver;
 use crate::error::{CompareError, Result};
-use crate::reference::{RefOutcome, Sample};
+use crate::reference::{RefGround, RefOutcome, Sample};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -113,17 +113,123 @@ impl CompareSetup {
         }
     }
 
-    /// The world as the comparison drives it: `world` with the setup's surface everywhere.
-    pub fn prepare(&self, world: &World) -> Result<World> {
-        Ok(world.with_uniform_surface(self.class, self.surface)?)
+    /// The world as the comparison drives it on `ground`: with the setup's surface everywhere
+    /// (one friction), as imported (one soil, which must be the reference's), or with each
+    /// patch's friction that of its section (`reference_dir/frictions/world-NNN.tsv`).
+    pub fn prepare(&self, world: &World, ground: RefGround, reference_dir: &Path) -> Result<World> {
+        match ground {
+            RefGround::OneFriction => Ok(world.with_uniform_surface(self.class, self.surface)?),
+            RefGround::Soil(class) => {
+                let other =
+                    world.patches.patches().iter().find(|p| {
+                        p.class != class || !matches!(p.surface, Surface::Deformable { .. })
+                    });
+                if let Some(p) = other {
+                    return Err(CompareError::Argument(format!(
+                        "{}: the reference ran it on {class} everywhere, but the imported world has {} patches: not a single-soil world",
+                        world.meta.name, p.class
+                    )));
+                }
+                Ok(world.clone())
+            }
+            RefGround::Sections => {
+                let path = reference_dir
+                    .join(FRICTIONS_DIR)
+                    .join(format!("world-{:03}.tsv", world.meta.index));
+                with_section_frictions(world, &path)
+            }
+        }
     }
 }
 
+/// Folder of a sections reference holding each world's sections and their frictions.
+pub const FRICTIONS_DIR: &str = "frictions";
+
+/// `world` with every patch's friction that of its section in the file at `path` (lines
+/// `i_min i_max j_min j_max friction`, tab-separated after a header; i is the patch row from the
+/// north, j the column from the west), restitution the reference's 0.01, classes kept. Every
+/// patch must be rigid and in exactly one section.
+pub fn with_section_frictions(world: &World, path: &Path) -> Result<World> {
+    use verti_world::surface::PATCHES_PER_SIDE as N;
+    let text = std::fs::read_to_string(path).map_err(|e| CompareError::io(path, e))?;
+    let mut friction: Vec<Option<f64>> = vec![None; N * N];
+    for (k, line) in text.lines().enumerate().skip(1) {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let bad = |problem: String| CompareError::line(path, k + 1, problem);
+        let cols: Vec<&str> = line.split('\t').collect();
+        if cols.len() != 5 {
+            return Err(bad(format!(
+                "expected 5 tab-separated columns (i_min i_max j_min j_max friction), found {}",
+                cols.len()
+            )));
+        }
+        let index = |c: &str| -> Result<usize> {
+            c.trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|&i| i < N)
+                .ok_or_else(|| bad(format!("`{c}` is not a patch index 0-{}", N - 1)))
+        };
+        let (i0, i1, j0, j1) = (
+            index(cols[0])?,
+            index(cols[1])?,
+            index(cols[2])?,
+            index(cols[3])?,
+        );
+        let f: f64 = cols[4]
+            .trim()
+            .parse()
+            .ok()
+            .filter(|f: &f64| f.is_finite() && (0.0..=2.0).contains(f))
+            .ok_or_else(|| bad(format!("`{}` is not a friction in [0, 2]", cols[4])))?;
+        if i1 < i0 || j1 < j0 {
+            return Err(bad("an empty section (max below min)".into()));
+        }
+        for i in i0..=i1 {
+            for j in j0..=j1 {
+                if friction[i * N + j].replace(f).is_some() {
+                    return Err(bad(format!("patch ({i}, {j}) is in two sections")));
+                }
+            }
+        }
+    }
+    let mut patches = world.patches.patches().to_vec();
+    for (k, p) in patches.iter_mut().enumerate() {
+        let (i, j) = (k / N, k % N);
+        let Some(f) = friction[k] else {
+            return Err(CompareError::Argument(format!(
+                "{}: patch ({i}, {j}) of {} is in no section",
+                path.display(),
+                world.meta.name
+            )));
+        };
+        if p.surface.is_deformable() {
+            return Err(CompareError::Argument(format!(
+                "{}: patch ({i}, {j}) of {} is deformable; sections are rigid",
+                path.display(),
+                world.meta.name
+            )));
+        }
+        p.surface = Surface::Rigid {
+            friction: f,
+            restitution: RIGID_RESTITUTION,
+        };
+    }
+    let mut out = world.clone();
+    out.patches = verti_world::PatchGrid::new(patches, world.terrain.cell());
+    Ok(out)
+}
+
 /// Imports the Verti-Bench worlds the tasks name from `vb_dir` (once each, in parallel) and
-/// prepares them with `setup`. Each must be the world the reference names (`vb/configN_LEVEL`
-/// for world index N), or the task's line is reported.
+/// prepares them with `setup` for the ground their tasks were run on ([`CompareSetup::prepare`];
+/// `reference_dir` holds the sections of a sections reference). Each must be the world the
+/// reference names (`vb/configN_LEVEL` for world index N), or the task's line is reported; the
+/// tasks of one world must share their ground.
 pub fn load_worlds(
     vb_dir: &Path,
+    reference_dir: &Path,
     tasks: &[&RefOutcome],
     setup: &CompareSetup,
 ) -> Result<BTreeMap<u32, Arc<World>>> {
@@ -142,7 +248,17 @@ pub fn load_worlds(
     let files = scan_vb_dir(vb_dir)?;
     let mut wanted: BTreeMap<u32, &RefOutcome> = BTreeMap::new();
     for t in tasks {
-        wanted.entry(t.world_index).or_insert(t);
+        let first = *wanted.entry(t.world_index).or_insert(t);
+        if first.ground != t.ground {
+            return Err(CompareError::Argument(format!(
+                "world {} is run on {} on line {} but on {} on line {}: one ground per world",
+                t.world_index,
+                first.ground.name(),
+                first.line,
+                t.ground.name(),
+                t.line
+            )));
+        }
     }
     let jobs: Vec<(u32, &RefOutcome)> = wanted.into_iter().collect();
     let worlds = jobs
@@ -171,7 +287,8 @@ pub fn load_worlds(
                     first.line
                 )));
             }
-            Ok((index, Arc::new(setup.prepare(&world)?)))
+            let prepared = setup.prepare(&world, first.ground, reference_dir)?;
+            Ok((index, Arc::new(prepared)))
         })
         .collect::<Result<Vec<_>>>()?;
     Ok(worlds.into_iter().collect())
@@ -270,4 +387,52 @@ pub fn resample(steps: &[StepRecord], period: f64) -> Vec<Sample> {
         });
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tsv(lines: &str) -> std::path::PathBuf {
+        static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let k = N.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let path =
+            std::env::temp_dir().join(format!("verti-sections-{}-{k}.tsv", std::process::id()));
+        std::fs::write(
+            &path,
+            format!("i_min\ti_max\tj_min\tj_max\tfriction\n{lines}"),
+        )
+        .unwrap();
+        path
+    }
+
+    #[test]
+    fn section_frictions_cover_every_patch_once() {
+        let world = verti_sim::testing::flat_world(1.0, 0.8);
+        let ok = tsv("0\t15\t0\t7\t0.5\n0\t15\t8\t15\t0.7\n");
+        let w = with_section_frictions(&world, &ok).unwrap();
+        let friction = |k: usize| match w.patches.patches()[k].surface {
+            Surface::Rigid { friction, .. } => friction,
+            Surface::Deformable { .. } => f64::NAN,
+        };
+        assert_eq!(
+            (friction(0), friction(7), friction(8), friction(255)),
+            (0.5, 0.5, 0.7, 0.7)
+        );
+        for (lines, why) in [
+            ("0\t15\t0\t7\t0.5\n", "is in no section"),
+            ("0\t15\t0\t15\t0.5\n0\t0\t0\t0\t0.6\n", "in two sections"),
+            ("0\t16\t0\t15\t0.5\n", "not a patch index"),
+            ("0\t15\t0\t15\tslippery\n", "not a friction"),
+            ("0\t15\t0\t15\n", "5 tab-separated columns"),
+        ] {
+            let e = with_section_frictions(&world, &tsv(lines))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains(why) && e.contains("verti-sections"),
+                "{lines:?}: {e}"
+            );
+        }
+    }
 }

@@ -37,6 +37,8 @@ pub struct TaskComparison {
     pub world_index: u32,
     pub pair: u32,
     pub level: ElevationLevel,
+    /// The ground the task was run on ([`crate::reference::RefGround::name`]).
+    pub ground: String,
     pub reference: EngineStats,
     pub verti: EngineStats,
     /// Same outcome class.
@@ -90,6 +92,7 @@ pub fn compare_task(reference: &RefTask, run: &VertiRun) -> TaskComparison {
         world_index: o.world_index,
         pair: o.pair,
         level: r.level,
+        ground: o.ground.name(),
         agree: verti.outcome == ref_stats.outcome,
         time_ratio,
         mean_roll_ratio: verti.mean_abs_roll / ref_stats.mean_abs_roll,
@@ -290,8 +293,11 @@ pub struct Summary {
     /// Reference engine, e.g. `chrono-9.0.1`.
     pub engine: String,
     pub setup: SetupRecord,
-    /// All tasks first, then each elevation level present.
+    /// All tasks first, then each elevation level present, then (when the tasks were run on
+    /// more than one-friction rigid ground) each ground present.
     pub groups: Vec<Aggregate>,
+    /// The grounds the tasks were run on, in order of first appearance.
+    pub grounds: Vec<String>,
     pub tasks: Vec<TaskComparison>,
     /// Each task re-run from jittered starts (`--ensemble`), when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -309,10 +315,23 @@ pub fn summarize(setup: &CompareSetup, engine: &str, tasks: Vec<TaskComparison>)
             groups.push(aggregate(level.name(), &of_level));
         }
     }
+    let mut grounds: Vec<String> = Vec::new();
+    for t in &all {
+        if !grounds.contains(&t.ground) {
+            grounds.push(t.ground.clone());
+        }
+    }
+    if grounds.iter().any(|g| g != "one-friction") {
+        for g in &grounds {
+            let on: Vec<&TaskComparison> = all.iter().copied().filter(|t| &t.ground == g).collect();
+            groups.push(aggregate(g, &on));
+        }
+    }
     Summary {
         engine: engine.to_string(),
         setup: SetupRecord::of(setup),
         groups,
+        grounds,
         tasks,
         ensemble: None,
     }

@@ -53,7 +53,13 @@ fn two_tasks_rerun_and_compare() {
     let chosen = select_tasks(&outcomes, "9:0,2:0").unwrap();
     let setup = CompareSetup::reference(verti_sim::vehicles::builtin("hmmwv").unwrap());
     let refs: Vec<_> = chosen.iter().map(|&i| &outcomes[i]).collect();
-    let worlds = load_worlds(&dir.join("verti-bench-data/worlds"), &refs, &setup).unwrap();
+    let worlds = load_worlds(
+        &dir.join("verti-bench-data/worlds"),
+        &dir.join("chrono-reference"),
+        &refs,
+        &setup,
+    )
+    .unwrap();
     assert_eq!(worlds.len(), 2);
     for w in worlds.values() {
         assert_eq!(w.meta.terrain_type, TerrainType::Rigid);
@@ -111,4 +117,54 @@ fn two_tasks_rerun_and_compare() {
     assert!(md.contains("| all tasks | 2 |"), "{md}");
     let json = serde_json::to_string(&s).unwrap();
     assert!(json.contains("\"engine\":\"chrono-9.0.1\""));
+}
+
+/// The soil and sections sets: each task's line names its ground, and the worlds are prepared
+/// for it (issue 34): single-soil worlds as imported, sections with their frictions.
+#[test]
+fn soil_and_sections_worlds_are_prepared_for_their_ground() {
+    use verti_compare::reference::RefGround;
+    use verti_world::{Surface, TerrainClass};
+    let Some(dir) = shared() else { return };
+    let setup = CompareSetup::reference(verti_sim::vehicles::builtin("hmmwv").unwrap());
+    let vb = dir.join("verti-bench-data/worlds");
+
+    let soil_dir = dir.join("chrono-reference/soil");
+    let soil = read_reference(&soil_dir).unwrap();
+    assert_eq!(soil.tasks.len(), 90);
+    let outcomes: Vec<_> = soil.tasks.iter().map(|t| t.outcome.clone()).collect();
+    let chosen = select_tasks(&outcomes, "82:0,62:0").unwrap();
+    let refs: Vec<_> = chosen.iter().map(|&i| &outcomes[i]).collect();
+    let on = |w: u32| refs.iter().find(|o| o.world_index == w).unwrap().ground;
+    assert_eq!(on(82), RefGround::Soil(TerrainClass::Snow));
+    assert_eq!(on(62), RefGround::Soil(TerrainClass::Sand));
+    let worlds = load_worlds(&vb, &soil_dir, &refs, &setup).unwrap();
+    let snow = &worlds[&82];
+    assert_eq!(snow.meta.terrain_type, TerrainType::Deformable);
+    assert!(snow.patches.patches().iter().all(|p| p.class == TerrainClass::Snow
+        && matches!(p.surface, Surface::Deformable { soil } if soil == verti_world::SoilParams::SOFT)));
+    assert!(
+        worlds[&62]
+            .patches
+            .patches()
+            .iter()
+            .all(|p| p.class == TerrainClass::Sand)
+    );
+
+    let sections_dir = dir.join("chrono-reference/sections");
+    let sections = read_reference(&sections_dir).unwrap();
+    let outcomes: Vec<_> = sections.tasks.iter().map(|t| t.outcome.clone()).collect();
+    let chosen = select_tasks(&outcomes, "1:0").unwrap();
+    let refs: Vec<_> = chosen.iter().map(|&i| &outcomes[i]).collect();
+    assert_eq!(refs[0].ground, RefGround::Sections);
+    let worlds = load_worlds(&vb, &sections_dir, &refs, &setup).unwrap();
+    // the first section of world 1 (patch rows 0-2, columns 0-4) has friction 0.6245...
+    let p = worlds[&1].patches.patches()[2 * 16 + 4];
+    assert!(
+        matches!(p.surface, Surface::Rigid { friction, .. } if (friction - 0.6245413657884453).abs() < 1e-15),
+        "{p:?}"
+    );
+    // and the worlds of a set with a missing section file are named
+    let err = load_worlds(&vb, &dir.join("chrono-reference"), &refs, &setup).unwrap_err();
+    assert!(err.to_string().contains("world-001.tsv"), "{err}");
 }

@@ -34,10 +34,9 @@
 //! the lattice's edge points and the vertices within half a cell of the edge (sampled on the
 //! edge) cover; an upturned vehicle has rolled over, and there the lattice acts as before.
 //!
-//! Only rigid ground: on a deformable patch the body meets the undeformed surface as a
-//! stand-in (Chrono lets the chassis pass through SCM soil), and a vehicle that has sunk to
-//! its hubs rides on its belly there; a finer view of that stand-in would move verti away
-//! from the reference, not toward it. Vertices on soil patches are left to the lattice.
+//! Only rigid ground: on a deformable patch the chassis passes through the soil, as in
+//! Chrono's SCM (see [`super::body`]), down to a floor well below any upright vehicle's
+//! reach; vertices on soil patches are left to the lattice.
 
 use crate::friction::surface_mu;
 use crate::model::Model;

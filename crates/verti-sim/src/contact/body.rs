@@ -1,4 +1,5 @@
-//! The chassis collision box against terrain (rigid, or the undeformed soil surface) and
+//! The chassis collision box against terrain (rigid ground; soil only as a floor far below its
+//! surface, since in Chrono's SCM the chassis passes through soil) and
 //! obstacles: a compliant normal force plus regularised Coulomb friction at each contact point.
 //! Against terrain: the 18 lattice points of the box, and the terrain vertices under its
 //! bottom face that stand above the ground the lattice sees ([`super::belly`]).
@@ -66,6 +67,14 @@ pub(crate) fn body_contacts(
     let box_bound = terrain.bound.max_in(x0, y0, x1, y1);
     if z0 < box_bound {
         let patches = world.patches.patches();
+        // Soil does not hold the chassis up: in Chrono's SCM only the wheels (the bodies with
+        // an active domain) meet the soil, and the chassis passes through it. Holding it at
+        // the undeformed surface instead left verti's HMMWV high-centred on snow wherever its
+        // wheels sank 0.2-0.4 m, stuck where Chrono's drives on (issue 34). A floor one wheel
+        // diameter below the surface remains, which no upright vehicle reaches while its
+        // wheels carry it: it keeps a capsized vehicle from falling through the map, as
+        // Chrono's can (a reference artifact, not physics).
+        let soil_floor = 2.0 * model.wheels.iter().map(|w| w.radius).fold(0.0, f64::max);
         // ground heights under the bottom points, where sampled (the belly pass reuses them)
         let mut bottom_h = [f64::NAN; 9];
         for (k, p) in pts.iter().enumerate() {
@@ -80,9 +89,16 @@ pub(crate) fn body_contacts(
             if h <= p.z {
                 continue;
             }
+            let surface = &patches[terrain.ground.patch_index(p.x, p.y)].surface;
+            let h = match surface {
+                verti_world::Surface::Deformable { .. } => h - soil_floor,
+                verti_world::Surface::Rigid { .. } => h,
+            };
+            if h <= p.z {
+                continue;
+            }
             let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
             let n = Vec3::new(-gx * nz, -gy * nz, nz);
-            let surface = &patches[terrain.ground.patch_index(p.x, p.y)].surface;
             let mu = surface_mu(surface).min(mu_body);
             if apply(*p, n, (h - p.z) * nz, mu, 1.0, 1.0) {
                 contacts.chassis_terrain_points += 1;
