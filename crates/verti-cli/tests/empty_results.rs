@@ -2,34 +2,10 @@
 //! tests failed before: the commands printed an empty table or wrote an unreadable dataset,
 //! and exited 0.
 
+mod common;
+
+use common::{s, tmp, verti};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn verti(args: &[&str]) -> (bool, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_verti"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        format!(
-            "{}{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        ),
-    )
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("verti-empty-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// A training world (never an evaluation one), generated here.
 fn world(root: &Path) -> PathBuf {
@@ -50,7 +26,7 @@ fn world(root: &Path) -> PathBuf {
 
 #[test]
 fn an_open_loop_horizon_longer_than_every_trajectory_is_refused() {
-    let root = tmp("kino");
+    let root = tmp("empty", "kino");
     let w = world(&root);
     let data = root.join("data");
     let (ok, text) = verti(&[
@@ -81,7 +57,7 @@ fn an_open_loop_horizon_longer_than_every_trajectory_is_refused() {
 
 #[test]
 fn an_expert_dataset_that_keeps_no_trial_is_refused() {
-    let root = tmp("expert");
+    let root = tmp("empty", "expert");
     let w = world(&root);
     let data = root.join("expert");
     // 10-s trials at 0.1 m/s: no goal is reached, so no demonstration is kept

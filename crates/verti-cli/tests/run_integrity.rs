@@ -1,46 +1,10 @@
 //! No trial can poison a run; shards and loaded files are part of a run's identity (issue 33,
 //! items 1-4). Each test here failed before its fix.
 
+mod common;
+
+use common::{fails, ok, s, tmp, verti};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn verti(args: &[&str]) -> (bool, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_verti"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        format!(
-            "{}{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        ),
-    )
-}
-
-fn ok(args: &[&str]) -> String {
-    let (success, text) = verti(args);
-    assert!(success, "verti {args:?} failed:\n{text}");
-    text
-}
-
-fn fails(args: &[&str]) -> String {
-    let (success, text) = verti(args);
-    assert!(!success, "verti {args:?} should fail:\n{text}");
-    text
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("verti-integrity-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 fn lines(path: &Path) -> Vec<String> {
     std::fs::read_to_string(path)
@@ -58,7 +22,7 @@ fn run_json(dir: &Path) -> serde_json::Value {
 /// `error` (no final distance); the run stays readable by every command.
 #[test]
 fn an_error_trial_does_not_poison_the_run() {
-    let root = tmp("error");
+    let root = tmp("integrity", "error");
     let vehicle = root.join("feather.yaml");
     let yaml = ok(&["vehicle", "show", "hmmwv", "--yaml"]);
     let yaml: String = yaml
@@ -116,7 +80,7 @@ fn an_error_trial_does_not_poison_the_run() {
 /// with `--allow-partial`), and keeps the shards' step logs.
 #[test]
 fn a_merge_needs_every_shard_and_keeps_their_step_logs() {
-    let root = tmp("merge");
+    let root = tmp("integrity", "merge");
     let eval = |out: &Path, shard: &str| {
         ok(&[
             "eval",
@@ -244,7 +208,7 @@ fn a_merge_needs_every_shard_and_keeps_their_step_logs() {
 /// the same path is refused, and a card missing for a selected world is refused up front.
 #[test]
 fn a_resume_checks_the_model_files_by_content() {
-    let root = tmp("models");
+    let root = tmp("integrity", "models");
     let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
     let copy = |card: &str| {
         for ext in ["yaml", "bin"] {

@@ -1,35 +1,9 @@
 //! Sharded evaluation joined by `verti merge`, and `--perception`, end to end.
 
+mod common;
+
+use common::{ok, s, tmp, verti};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn verti(args: &[&str]) -> (bool, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_verti"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        format!(
-            "{}{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        ),
-    )
-}
-
-fn ok(args: &[&str]) -> String {
-    let (success, text) = verti(args);
-    assert!(success, "verti {args:?} failed:\n{text}");
-    text
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("verti-shard-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// Results by task, without the wall time (the one field that differs between runs).
 fn results(dir: &Path) -> Vec<serde_json::Value> {
@@ -47,13 +21,9 @@ fn results(dir: &Path) -> Vec<serde_json::Value> {
     rows
 }
 
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
 #[test]
 fn shards_merge_into_what_one_run_writes() {
-    let root = tmp("merge");
+    let root = tmp("shard", "merge");
     let full = root.join("full");
     let eval = |out: &Path, extra: &[&str]| {
         let mut args = vec![
@@ -149,7 +119,7 @@ fn shards_merge_into_what_one_run_writes() {
 
 #[test]
 fn perception_noise_changes_what_systems_see_and_is_recorded() {
-    let root = tmp("perception");
+    let root = tmp("shard", "perception");
     let eval = |out: &Path, extra: &[&str]| {
         let mut args = vec![
             "eval",

@@ -39,6 +39,22 @@ pub(crate) struct WheelKinematics {
     pub spin: f64,
 }
 
+#[cfg(test)]
+impl WheelKinematics {
+    /// An upright wheel at rest at `hub`, axle along +y, its hub the centre of mass (tests).
+    pub fn at_rest(hub: Vec3) -> WheelKinematics {
+        WheelKinematics {
+            arm: Vec3::ZERO,
+            hub,
+            axle: Vec3::Y,
+            hub_velocity: Vec3::ZERO,
+            up: Vec3::Z,
+            chassis_omega: Vec3::ZERO,
+            spin: 0.0,
+        }
+    }
+}
+
 /// Contact of one wheel with everything (summed).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WheelContact {

@@ -446,15 +446,7 @@ mod tests {
         let model = Model::compile(&spec, 1.0);
         let terrain = Terrain::new(&Arc::new(world), model.reach).unwrap();
         let mut soil = SoilState::new(terrain.soil.as_ref());
-        let kin = WheelKinematics {
-            arm: Vec3::ZERO,
-            hub,
-            axle: Vec3::Y,
-            hub_velocity: Vec3::ZERO,
-            up: Vec3::Z,
-            chassis_omega: Vec3::ZERO,
-            spin: 0.0,
-        };
+        let kin = WheelKinematics::at_rest(hub);
         let near = terrain.obstacles.near(hub.x, hub.y).to_vec();
         let m = &model.wheels[0];
         let (c, rc) = rigid_wheel_contact(&terrain, &mut soil, &spec.tyre, m, 0.3, &kin, &near);

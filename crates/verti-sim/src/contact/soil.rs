@@ -209,15 +209,7 @@ mod tests {
         let layout = terrain.soil.unwrap();
         let mut state = SoilState::new(Some(&layout));
         let (mut b, mut c) = (0.3, WheelContact::default());
-        let mut kin = WheelKinematics {
-            arm: Vec3::ZERO,
-            hub,
-            axle: Vec3::Y,
-            hub_velocity: Vec3::ZERO,
-            up: Vec3::Z,
-            chassis_omega: Vec3::ZERO,
-            spin: 0.0,
-        };
+        let mut kin = WheelKinematics::at_rest(hub);
         while c.force.z < load {
             hub.z -= 1e-5;
             kin.hub = hub;
