@@ -17,28 +17,12 @@ use verti_core::rng::Rng;
 use verti_data::manifest::{FORMAT, MANIFEST, Manifest, WorldsInfo, checksum};
 use verti_data::table::{FEATURES, Row, TrialRecord, WheelGround};
 use verti_data::{DataOutcome, Dataset, Kind, Profile, write_trials};
+use verti_testkit::config;
+use verti_testkit::mutate::{Edit, apply, edit_strategy, edited, flip_edit, text_edit_strategy};
 
-/// `default` cases, or `PROPTEST_CASES` when set (a longer run than CI's).
-fn config(default: u32) -> ProptestConfig {
-    let cases = std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default);
-    ProptestConfig {
-        cases,
-        // a failure is printed shrunk; no regression file is written into the source tree
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
-}
-
-/// A fresh directory per call (cases may run on several threads of one process).
+/// A fresh, empty directory per call (cases may run on several threads of one process).
 fn case_dir(tag: &str) -> PathBuf {
-    static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let k = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let d = std::env::temp_dir().join(format!("verti-data-fuzz-{tag}-{}-{k}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+    verti_testkit::case_dir("verti-data-fuzz", tag)
 }
 
 /// A trial of `n` rows with distinct values in every column (4 wheels).
@@ -157,7 +141,6 @@ fn vouched_manifest(text: &str, files: &[(String, Vec<u8>)], sum: Sum) -> String
 /// an error naming a file of the dataset. A panic fails the caller.
 fn load_with(replaced: &[(String, Vec<u8>)]) -> Result<(), String> {
     let dir = case_dir("load");
-    std::fs::create_dir_all(&dir).unwrap();
     for (name, real) in real_files() {
         let bytes = replaced
             .iter()
@@ -236,111 +219,11 @@ fn smashed_parquet_with_a_matching_or_absent_checksum_is_an_error_naming_the_fil
     );
 }
 
-/// One edit of a byte string; positions are taken modulo the current length.
-#[derive(Clone, Debug)]
-enum Edit {
-    Flip(usize, u8),
-    Insert(usize, Vec<u8>),
-    Delete(usize, usize),
-    Truncate(usize),
-    /// Replace the n-th number in the text by an extreme one.
-    Number(usize, &'static str),
-}
-
-/// The world fuzzer's extreme numbers, and counts that would size an allocation.
-const EXTREMES: [&str; 15] = [
-    "1e30",
-    "-1e30",
-    "1e308",
-    "-0.0",
-    "0",
-    "-1",
-    ".nan",
-    ".inf",
-    "1e-320",
-    "4294967296",
-    "99999999999999999999",
-    "0.5",
-    "1",
-    "65536",
-    "18446744073709551615",
-];
-
-/// Edits of a binary file: any byte values.
-fn edit_strategy() -> impl Strategy<Value = Edit> {
-    prop_oneof![
-        4 => (any::<usize>(), 1u8..=255).prop_map(|(p, x)| Edit::Flip(p, x)),
-        1 => (any::<usize>(), prop::collection::vec(any::<u8>(), 1..16))
-            .prop_map(|(p, b)| Edit::Insert(p, b)),
-        1 => (any::<usize>(), 1usize..64).prop_map(|(p, n)| Edit::Delete(p, n)),
-        1 => any::<usize>().prop_map(Edit::Truncate),
-    ]
-}
-
-/// Edits of YAML text that keep it ASCII; extreme numbers are the most common edit, since a
-/// manifest that still parses reaches the most checks.
-fn text_edit_strategy() -> impl Strategy<Value = Edit> {
-    let yaml_bytes = prop::sample::select(b"[]{},:-#&*!|>'\" 0123456789.eE+abc\n\t".to_vec());
-    prop_oneof![
-        1 => (any::<usize>(), 1u8..=127).prop_map(|(p, x)| Edit::Flip(p, x)),
-        1 => (any::<usize>(), prop::collection::vec(yaml_bytes, 1..16))
-            .prop_map(|(p, b)| Edit::Insert(p, b)),
-        1 => (any::<usize>(), 1usize..64).prop_map(|(p, n)| Edit::Delete(p, n)),
-        1 => any::<usize>().prop_map(Edit::Truncate),
-        4 => (any::<usize>(), prop::sample::select(EXTREMES.to_vec()))
-            .prop_map(|(n, v)| Edit::Number(n, v)),
-    ]
-}
-
-/// Start and end of every number-looking token (after a space, `[`, `,` or `:`).
-fn number_spans(b: &[u8]) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        let starts = (b[i].is_ascii_digit() || b[i] == b'-')
-            && i > 0
-            && matches!(b[i - 1], b' ' | b'[' | b',' | b':');
-        if starts {
-            let j = i + b[i..]
-                .iter()
-                .take_while(|c| c.is_ascii_digit() || matches!(c, b'.' | b'e' | b'-' | b'+'))
-                .count();
-            out.push((i, j));
-            i = j;
-        } else {
-            i += 1;
-        }
-    }
-    out
-}
-
-fn apply(bytes: &mut Vec<u8>, edit: &Edit) {
-    let at = |p: usize, len: usize| if len == 0 { 0 } else { p % len };
-    match edit {
-        Edit::Flip(p, x) => {
-            if !bytes.is_empty() {
-                let i = at(*p, bytes.len());
-                bytes[i] ^= x;
-            }
-        }
-        Edit::Insert(p, b) => {
-            let i = at(*p, bytes.len() + 1);
-            bytes.splice(i..i, b.iter().copied());
-        }
-        Edit::Delete(p, n) => {
-            let i = at(*p, bytes.len());
-            let j = (i + n).min(bytes.len());
-            bytes.drain(i..j);
-        }
-        Edit::Truncate(p) => bytes.truncate(at(*p, bytes.len() + 1)),
-        Edit::Number(n, v) => {
-            let spans = number_spans(bytes);
-            if !spans.is_empty() {
-                let (i, j) = spans[n % spans.len()];
-                bytes.splice(i..j, v.bytes());
-            }
-        }
-    }
+/// Edits of a binary file: any byte values, flips four times as likely as each other kind
+/// (4 : 1 : 1 : 1), since a flip keeps the file's length and offsets and so reaches further
+/// into the Parquet decoder.
+fn parquet_edit_strategy() -> impl Strategy<Value = Edit> {
+    prop_oneof![3 => flip_edit(), 4 => edit_strategy()]
 }
 
 fn sum_strategy() -> impl Strategy<Value = Sum> {
@@ -356,7 +239,7 @@ proptest! {
 
     #[test]
     fn mutated_parquet_never_panics(
-        edits in prop::collection::vec(edit_strategy(), 1..6),
+        edits in prop::collection::vec(parquet_edit_strategy(), 1..6),
         sum in sum_strategy(),
     ) {
         let r = smashed(|b| edits.iter().for_each(|e| apply(b, e)), sum);
@@ -365,10 +248,7 @@ proptest! {
 
     #[test]
     fn mutated_manifests_never_panic(edits in prop::collection::vec(text_edit_strategy(), 1..6)) {
-        let mut text = real_files()[0].1.clone();
-        for e in &edits {
-            apply(&mut text, e);
-        }
+        let text = edited(&real_files()[0].1, &edits);
         let _ = load_with(&[(MANIFEST.to_string(), text)]);
     }
 
@@ -382,7 +262,6 @@ proptest! {
 #[test]
 fn a_missing_parquet_file_is_named() {
     let dir = case_dir("missing");
-    std::fs::create_dir_all(&dir).unwrap();
     let (manifest, parquet) = (&real_files()[0], &real_files()[1]);
     std::fs::write(dir.join(&manifest.0), &manifest.1).unwrap();
     let e = Dataset::load(&dir).unwrap_err().to_string();

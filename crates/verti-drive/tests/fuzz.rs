@@ -16,6 +16,7 @@ use std::time::Duration;
 use verti_drive::Keys;
 use verti_drive::access::Access;
 use verti_drive::http::{MAX_BODY, ParseError, head_len, parse_head, parse_request};
+use verti_testkit::mutate;
 
 /// Requests as the page, a browser and an attacker send them.
 const SEEDS: [&str; 6] = [
@@ -27,52 +28,36 @@ const SEEDS: [&str; 6] = [
     "POST /step HTTP/1.1\r\nHost: 127.0.0.1:8765\r\nContent-Length: 5\r\nContent-Length: 5\r\nTransfer-Encoding: chunked\r\n\r\n0\r\n\r\n",
 ];
 
+/// An edit of a request: one of the shared byte edits, or a line repeated.
 #[derive(Clone, Debug)]
 enum Edit {
-    Flip(usize, u8),
-    Insert(usize, Vec<u8>),
-    Delete(usize, usize),
-    Truncate(usize),
+    Bytes(mutate::Edit),
     /// Repeat the line containing this position (duplicate headers, request lines).
     RepeatLine(usize),
 }
 
 fn edit_strategy() -> impl Strategy<Value = Edit> {
+    use mutate::Edit::{Delete, Insert, Truncate};
     // HTTP's own syntax characters, so edits reach past the first check
     let http = prop::sample::select(b"\r\n :/?&=%+,-0123456789aAfFzZ.\t\xff\x00".to_vec());
     prop_oneof![
-        (any::<usize>(), 1u8..=255).prop_map(|(p, x)| Edit::Flip(p, x)),
-        (any::<usize>(), prop::collection::vec(http, 1..12)).prop_map(|(p, b)| Edit::Insert(p, b)),
+        mutate::flip_edit().prop_map(Edit::Bytes),
+        (any::<usize>(), prop::collection::vec(http, 1..12))
+            .prop_map(|(p, b)| Edit::Bytes(Insert(p, b))),
         (any::<usize>(), prop::collection::vec(any::<u8>(), 1..8))
-            .prop_map(|(p, b)| Edit::Insert(p, b)),
-        (any::<usize>(), 1usize..32).prop_map(|(p, n)| Edit::Delete(p, n)),
-        any::<usize>().prop_map(Edit::Truncate),
+            .prop_map(|(p, b)| Edit::Bytes(Insert(p, b))),
+        (any::<usize>(), 1usize..32).prop_map(|(p, n)| Edit::Bytes(Delete(p, n))),
+        any::<usize>().prop_map(|p| Edit::Bytes(Truncate(p))),
         any::<usize>().prop_map(Edit::RepeatLine),
     ]
 }
 
 fn apply(bytes: &mut Vec<u8>, edit: &Edit) {
-    let at = |p: usize, len: usize| if len == 0 { 0 } else { p % len };
     match edit {
-        Edit::Flip(p, x) => {
-            if !bytes.is_empty() {
-                let i = at(*p, bytes.len());
-                bytes[i] ^= x;
-            }
-        }
-        Edit::Insert(p, b) => {
-            let i = at(*p, bytes.len() + 1);
-            bytes.splice(i..i, b.iter().copied());
-        }
-        Edit::Delete(p, n) => {
-            let i = at(*p, bytes.len());
-            let j = (i + n).min(bytes.len());
-            bytes.drain(i..j);
-        }
-        Edit::Truncate(p) => bytes.truncate(at(*p, bytes.len() + 1)),
+        Edit::Bytes(e) => mutate::apply(bytes, e),
         Edit::RepeatLine(p) => {
             if !bytes.is_empty() {
-                let i = at(*p, bytes.len());
+                let i = p % bytes.len();
                 let start = bytes[..i]
                     .iter()
                     .rposition(|&b| b == b'\n')

@@ -17,20 +17,8 @@ use std::sync::OnceLock;
 use verti_nn::card::fnv1a64;
 use verti_nn::network::parse_card;
 use verti_nn::{LayerSpec, Mlp, ModelCard, ModelError, Network, Shape};
-
-/// `default` cases, or `PROPTEST_CASES` when set (a longer run than CI's).
-fn config(default: u32) -> ProptestConfig {
-    let cases = std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default);
-    ProptestConfig {
-        cases,
-        // a failure is printed shrunk; no regression file is written into the source tree
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
-}
+use verti_testkit::config;
+use verti_testkit::mutate::{EXTREMES, edit_strategy, edited, number_edit, text_edit_strategy};
 
 /// A card and its weights: (card text, weight file name, weight bytes).
 struct Seed {
@@ -93,134 +81,7 @@ fn seeds() -> &'static [Seed] {
 
 /// A fresh directory per call (cases may run on several threads of one process).
 fn case_dir(tag: &str) -> PathBuf {
-    static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let k = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let d = std::env::temp_dir().join(format!("verti-nn-fuzz-{tag}-{}-{k}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// One edit of a byte string; positions are taken modulo the current length.
-#[derive(Clone, Debug)]
-enum Edit {
-    Flip(usize, u8),
-    Insert(usize, Vec<u8>),
-    Delete(usize, usize),
-    Truncate(usize),
-    /// Replace the n-th number in the text by an extreme one.
-    Number(usize, &'static str),
-}
-
-/// Extreme numbers: the world fuzzer's, and sizes whose products overflow `usize` (2^32,
-/// 2^62, 2^63, 2^64 - 1) or reach an edge (0, 1).
-const EXTREMES: [&str; 20] = [
-    "1e30",
-    "-1e30",
-    "1e308",
-    "-0.0",
-    "0",
-    "1",
-    "2",
-    "-1",
-    ".nan",
-    ".inf",
-    "1e-320",
-    "0.5",
-    "65536",
-    "4294967296",
-    "4294967297",
-    "2147483648",
-    "4611686018427387904",
-    "9223372036854775808",
-    "18446744073709551615",
-    "99999999999999999999",
-];
-
-/// Edits of a binary file: any byte values.
-fn edit_strategy() -> impl Strategy<Value = Edit> {
-    prop_oneof![
-        (any::<usize>(), 1u8..=255).prop_map(|(p, x)| Edit::Flip(p, x)),
-        (any::<usize>(), prop::collection::vec(any::<u8>(), 1..16))
-            .prop_map(|(p, b)| Edit::Insert(p, b)),
-        (any::<usize>(), 1usize..64).prop_map(|(p, n)| Edit::Delete(p, n)),
-        any::<usize>().prop_map(Edit::Truncate),
-    ]
-}
-
-/// Edits of YAML text that keep it ASCII, so most cases reach the parser and the checks;
-/// extreme numbers are the most common edit, since a card that still parses reaches the most
-/// checks.
-fn text_edit_strategy() -> impl Strategy<Value = Edit> {
-    let yaml_bytes = prop::sample::select(b"[]{},:-#&*!|>'\" 0123456789.eE+abc\n\t".to_vec());
-    prop_oneof![
-        1 => (any::<usize>(), 1u8..=127).prop_map(|(p, x)| Edit::Flip(p, x)),
-        1 => (any::<usize>(), prop::collection::vec(yaml_bytes, 1..16))
-            .prop_map(|(p, b)| Edit::Insert(p, b)),
-        1 => (any::<usize>(), 1usize..64).prop_map(|(p, n)| Edit::Delete(p, n)),
-        1 => any::<usize>().prop_map(Edit::Truncate),
-        4 => (any::<usize>(), prop::sample::select(EXTREMES.to_vec()))
-            .prop_map(|(n, v)| Edit::Number(n, v)),
-    ]
-}
-
-/// Start and end of every number-looking token (after a space, `[`, `,` or `:`).
-fn number_spans(b: &[u8]) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        let starts = (b[i].is_ascii_digit() || b[i] == b'-')
-            && i > 0
-            && matches!(b[i - 1], b' ' | b'[' | b',' | b':');
-        if starts {
-            let j = i + b[i..]
-                .iter()
-                .take_while(|c| c.is_ascii_digit() || matches!(c, b'.' | b'e' | b'-' | b'+'))
-                .count();
-            out.push((i, j));
-            i = j;
-        } else {
-            i += 1;
-        }
-    }
-    out
-}
-
-fn apply(bytes: &mut Vec<u8>, edit: &Edit) {
-    let at = |p: usize, len: usize| if len == 0 { 0 } else { p % len };
-    match edit {
-        Edit::Flip(p, x) => {
-            if !bytes.is_empty() {
-                let i = at(*p, bytes.len());
-                bytes[i] ^= x;
-            }
-        }
-        Edit::Insert(p, b) => {
-            let i = at(*p, bytes.len() + 1);
-            bytes.splice(i..i, b.iter().copied());
-        }
-        Edit::Delete(p, n) => {
-            let i = at(*p, bytes.len());
-            let j = (i + n).min(bytes.len());
-            bytes.drain(i..j);
-        }
-        Edit::Truncate(p) => bytes.truncate(at(*p, bytes.len() + 1)),
-        Edit::Number(n, v) => {
-            let spans = number_spans(bytes);
-            if !spans.is_empty() {
-                let (i, j) = spans[n % spans.len()];
-                bytes.splice(i..j, v.bytes());
-            }
-        }
-    }
-}
-
-fn edited(bytes: &[u8], edits: &[Edit]) -> Vec<u8> {
-    let mut b = bytes.to_vec();
-    for e in edits {
-        apply(&mut b, e);
-    }
-    b
+    verti_testkit::case_dir("verti-nn-fuzz", tag)
 }
 
 /// Most multiply-adds a loaded network is run for (the fuzzer checks that a network that
@@ -403,11 +264,7 @@ proptest! {
     #[test]
     fn resigned_cards_with_extreme_sizes_never_panic(
         seed in 0usize..2,
-        edits in prop::collection::vec(
-            (any::<usize>(), prop::sample::select(EXTREMES.to_vec()))
-                .prop_map(|(n, v)| Edit::Number(n, v)),
-            1..4,
-        ),
+        edits in prop::collection::vec(number_edit(EXTREMES), 1..4),
     ) {
         let s = &seeds()[seed];
         let text = String::from_utf8(edited(s.card.as_bytes(), &edits)).unwrap();

@@ -13,36 +13,13 @@ use proptest::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, OnceLock};
 use verti_sim::{Controls, Sim, SpecError, StartPose, VehicleSpec, testing, vehicles};
+use verti_testkit::config;
+use verti_testkit::mutate::{self, Edit, edited, number_spans, text_edit_strategy_with};
 use verti_world::World;
-
-/// `default` cases, or `PROPTEST_CASES` when set (a longer run than CI's).
-fn config(default: u32) -> ProptestConfig {
-    let cases = std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default);
-    ProptestConfig {
-        cases,
-        // a failure is printed shrunk; no regression file is written into the source tree
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
-}
-
-/// One edit of a byte string; positions are taken modulo the current length.
-#[derive(Clone, Debug)]
-enum Edit {
-    Flip(usize, u8),
-    Insert(usize, Vec<u8>),
-    Delete(usize, usize),
-    Truncate(usize),
-    /// Replace the n-th number in the text by an extreme one.
-    Number(usize, &'static str),
-}
 
 /// The world fuzzer's extreme numbers and the issue's (1e-30, 1e308, -1, .nan, .inf), with
 /// their negatives and tiny ones near the edge of validity.
-const EXTREMES: [&str; 18] = [
+const EXTREMES: &[&str] = &[
     "1e-30",
     "1e308",
     "-1e308",
@@ -63,73 +40,15 @@ const EXTREMES: [&str; 18] = [
     "1e15",
 ];
 
-/// Edits of YAML text that keep it ASCII; extreme numbers are the most common edit, since a
-/// file that still parses reaches the most checks and the simulator.
+/// Edits of YAML text that keep it ASCII; extreme numbers are the most common edit (six in
+/// ten: four parts of the common text mix, half of which are swaps, and one of swaps alone),
+/// since a file that still parses reaches the most checks and the simulator.
 fn text_edit_strategy() -> impl Strategy<Value = Edit> {
-    let yaml_bytes = prop::sample::select(b"[]{},:-#&*!|>'\" 0123456789.eE+abc\n\t".to_vec());
-    prop_oneof![
-        1 => (any::<usize>(), 1u8..=127).prop_map(|(p, x)| Edit::Flip(p, x)),
-        1 => (any::<usize>(), prop::collection::vec(yaml_bytes, 1..16))
-            .prop_map(|(p, b)| Edit::Insert(p, b)),
-        1 => (any::<usize>(), 1usize..64).prop_map(|(p, n)| Edit::Delete(p, n)),
-        1 => any::<usize>().prop_map(Edit::Truncate),
-        6 => number_edit(),
-    ]
+    prop_oneof![4 => text_edit_strategy_with(EXTREMES), 1 => number_edit()]
 }
 
 fn number_edit() -> impl Strategy<Value = Edit> {
-    (any::<usize>(), prop::sample::select(EXTREMES.to_vec())).prop_map(|(n, v)| Edit::Number(n, v))
-}
-
-/// Start and end of every number-looking token (after a space, `[`, `,` or `:`).
-fn number_spans(b: &[u8]) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        let starts = (b[i].is_ascii_digit() || b[i] == b'-')
-            && i > 0
-            && matches!(b[i - 1], b' ' | b'[' | b',' | b':');
-        if starts {
-            let j = i + b[i..]
-                .iter()
-                .take_while(|c| c.is_ascii_digit() || matches!(c, b'.' | b'e' | b'-' | b'+'))
-                .count();
-            out.push((i, j));
-            i = j;
-        } else {
-            i += 1;
-        }
-    }
-    out
-}
-
-fn apply(bytes: &mut Vec<u8>, edit: &Edit) {
-    let at = |p: usize, len: usize| if len == 0 { 0 } else { p % len };
-    match edit {
-        Edit::Flip(p, x) => {
-            if !bytes.is_empty() {
-                let i = at(*p, bytes.len());
-                bytes[i] ^= x;
-            }
-        }
-        Edit::Insert(p, b) => {
-            let i = at(*p, bytes.len() + 1);
-            bytes.splice(i..i, b.iter().copied());
-        }
-        Edit::Delete(p, n) => {
-            let i = at(*p, bytes.len());
-            let j = (i + n).min(bytes.len());
-            bytes.drain(i..j);
-        }
-        Edit::Truncate(p) => bytes.truncate(at(*p, bytes.len() + 1)),
-        Edit::Number(n, v) => {
-            let spans = number_spans(bytes);
-            if !spans.is_empty() {
-                let (i, j) = spans[n % spans.len()];
-                bytes.splice(i..j, v.bytes());
-            }
-        }
-    }
+    mutate::number_edit(EXTREMES)
 }
 
 /// A flat world of `scale`, built once per scale (the vehicle drives a world of its own).
@@ -188,11 +107,7 @@ fn read_and_drive(text: &[u8]) -> Result<(), TestCaseError> {
 }
 
 fn mutated(name: &str, edits: &[Edit]) -> Vec<u8> {
-    let mut b = vehicles::builtin_yaml(name).unwrap().as_bytes().to_vec();
-    for e in edits {
-        apply(&mut b, e);
-    }
-    b
+    edited(vehicles::builtin_yaml(name).unwrap().as_bytes(), edits)
 }
 
 proptest! {

@@ -7,6 +7,9 @@
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
+use verti_testkit::mutate::{
+    EXTREMES, Edit, edit_strategy, edited, number_edit, text_edit_strategy,
+};
 use verti_world::format::{ELEVATION, LABELS, MANIFEST, load_world, save_world};
 use verti_world::generate::elevation::ProceduralRock;
 use verti_world::generate::{SetConfig, composition, generate_world, one_default_world};
@@ -29,122 +32,6 @@ fn real_world_files() -> &'static Vec<(&'static str, Vec<u8>)> {
     })
 }
 
-/// A fresh directory per call (cases may run on several threads of one process).
-fn case_dir(tag: &str) -> PathBuf {
-    static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let k = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let d = std::env::temp_dir().join(format!("verti-fuzz-{tag}-{}-{k}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// One edit of a byte string; positions are taken modulo the current length.
-#[derive(Clone, Debug)]
-enum Edit {
-    Flip(usize, u8),
-    Insert(usize, Vec<u8>),
-    Delete(usize, usize),
-    Truncate(usize),
-    /// Replace the n-th number in the text by an extreme one.
-    Number(usize, &'static str),
-}
-
-const EXTREMES: [&str; 12] = [
-    "1e30",
-    "-1e30",
-    "1e308",
-    "-0.0",
-    "0",
-    "-1",
-    ".nan",
-    ".inf",
-    "1e-320",
-    "4294967296",
-    "99999999999999999999",
-    "0.5",
-];
-
-/// Edits of a binary file: any byte values.
-fn edit_strategy() -> impl Strategy<Value = Edit> {
-    prop_oneof![
-        (any::<usize>(), 1u8..=255).prop_map(|(p, x)| Edit::Flip(p, x)),
-        (any::<usize>(), prop::collection::vec(any::<u8>(), 1..16))
-            .prop_map(|(p, b)| Edit::Insert(p, b)),
-        (any::<usize>(), 1usize..64).prop_map(|(p, n)| Edit::Delete(p, n)),
-        any::<usize>().prop_map(Edit::Truncate),
-        (any::<usize>(), prop::sample::select(EXTREMES.to_vec()))
-            .prop_map(|(n, v)| Edit::Number(n, v)),
-    ]
-}
-
-/// Edits of YAML text that keep it ASCII, so most cases get past the UTF-8 check into the
-/// parser and the validation; extreme numbers are the most common edit, since a file that
-/// still parses reaches the most checks.
-fn text_edit_strategy() -> impl Strategy<Value = Edit> {
-    let yaml_bytes = prop::sample::select(b"[]{},:-#&*!|>'\" 0123456789.eE+abc\n\t".to_vec());
-    prop_oneof![
-        1 => (any::<usize>(), 1u8..=127).prop_map(|(p, x)| Edit::Flip(p, x)),
-        1 => (any::<usize>(), prop::collection::vec(yaml_bytes, 1..16))
-            .prop_map(|(p, b)| Edit::Insert(p, b)),
-        1 => (any::<usize>(), 1usize..64).prop_map(|(p, n)| Edit::Delete(p, n)),
-        1 => any::<usize>().prop_map(Edit::Truncate),
-        4 => (any::<usize>(), prop::sample::select(EXTREMES.to_vec()))
-            .prop_map(|(n, v)| Edit::Number(n, v)),
-    ]
-}
-
-/// Start and end of every number-looking token (after a space, `[`, `,` or `:`).
-fn number_spans(b: &[u8]) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        let starts = (b[i].is_ascii_digit() || b[i] == b'-')
-            && i > 0
-            && matches!(b[i - 1], b' ' | b'[' | b',' | b':');
-        if starts {
-            let j = i + b[i..]
-                .iter()
-                .take_while(|c| c.is_ascii_digit() || matches!(c, b'.' | b'e' | b'-' | b'+'))
-                .count();
-            out.push((i, j));
-            i = j;
-        } else {
-            i += 1;
-        }
-    }
-    out
-}
-
-fn apply(bytes: &mut Vec<u8>, edit: &Edit) {
-    let at = |p: usize, len: usize| if len == 0 { 0 } else { p % len };
-    match edit {
-        Edit::Flip(p, x) => {
-            if !bytes.is_empty() {
-                let i = at(*p, bytes.len());
-                bytes[i] ^= x;
-            }
-        }
-        Edit::Insert(p, b) => {
-            let i = at(*p, bytes.len() + 1);
-            bytes.splice(i..i, b.iter().copied());
-        }
-        Edit::Delete(p, n) => {
-            let i = at(*p, bytes.len());
-            let j = (i + n).min(bytes.len());
-            bytes.drain(i..j);
-        }
-        Edit::Truncate(p) => bytes.truncate(at(*p, bytes.len() + 1)),
-        Edit::Number(n, v) => {
-            let spans = number_spans(bytes);
-            if !spans.is_empty() {
-                let (i, j) = spans[n % spans.len()];
-                bytes.splice(i..j, v.bytes());
-            }
-        }
-    }
-}
-
 /// Writes the real world with `file` replaced by `bytes` and loads it.
 fn load_with(file: &str, bytes: &[u8]) {
     let dir = case_dir("load");
@@ -158,16 +45,23 @@ fn load_with(file: &str, bytes: &[u8]) {
 }
 
 fn mutated(file: &str, edits: &[Edit]) -> Vec<u8> {
-    let mut bytes = real_world_files()
+    let real = &real_world_files()
         .iter()
         .find(|(n, _)| *n == file)
         .unwrap()
-        .1
-        .clone();
-    for e in edits {
-        apply(&mut bytes, e);
-    }
-    bytes
+        .1;
+    edited(real, edits)
+}
+
+/// Edits of a binary file: any byte values, and numbers swapped for extreme ones (one edit in
+/// five), which reach the shape written in an `.npy` header.
+fn binary_edit_strategy() -> impl Strategy<Value = Edit> {
+    prop_oneof![4 => edit_strategy(), 1 => number_edit(EXTREMES)]
+}
+
+/// A fresh directory per call (cases may run on several threads of one process).
+fn case_dir(tag: &str) -> PathBuf {
+    verti_testkit::case_dir("verti-fuzz", tag)
 }
 
 /// A 129 x 129 8-bit palettised grey BMP, laid out like the Verti-Bench heightmaps.
@@ -203,7 +97,7 @@ fn bmp_path(dir: &Path) -> PathBuf {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(verti_testkit::config(64))]
 
     #[test]
     fn mutated_manifests_never_panic(edits in prop::collection::vec(text_edit_strategy(), 1..6)) {
@@ -218,18 +112,15 @@ proptest! {
     #[test]
     fn mutated_arrays_never_panic(
         which in prop::bool::ANY,
-        edits in prop::collection::vec(edit_strategy(), 1..6),
+        edits in prop::collection::vec(binary_edit_strategy(), 1..6),
     ) {
         let file = if which { ELEVATION } else { LABELS };
         load_with(file, &mutated(file, &edits));
     }
 
     #[test]
-    fn mutated_heightmaps_never_panic(edits in prop::collection::vec(edit_strategy(), 1..6)) {
-        let mut bytes = grey_bmp();
-        for e in &edits {
-            apply(&mut bytes, e);
-        }
+    fn mutated_heightmaps_never_panic(edits in prop::collection::vec(binary_edit_strategy(), 1..6)) {
+        let bytes = edited(&grey_bmp(), &edits);
         let dir = case_dir("bmp");
         std::fs::write(bmp_path(&dir), &bytes).unwrap();
         let _ = read_grey_bmp(&bmp_path(&dir));
@@ -264,7 +155,7 @@ fn scale_strategy() -> impl Strategy<Value = f64> {
 
 proptest! {
     // generation is the expensive case (a world with its paths): fewer cases
-    #![proptest_config(ProptestConfig::with_cases(16))]
+    #![proptest_config(verti_testkit::config(16))]
 
     #[test]
     fn generation_never_panics_and_refuses_only_out_of_range_scales(
