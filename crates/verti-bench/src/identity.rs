@@ -124,6 +124,13 @@ pub struct SplitRecord {
     pub of: String,
 }
 
+impl SplitRecord {
+    /// What `split` says a run is: `shard i/N of tasks ...`, or `a whole run`.
+    pub fn describe(split: Option<&SplitRecord>) -> String {
+        split.map_or("a whole run".into(), |s| s.to_string())
+    }
+}
+
 impl std::fmt::Display for SplitRecord {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
@@ -289,13 +296,11 @@ impl RunRecord {
             out.extend(param_differences(&b.params, &a.params));
         }
         out.extend(input_differences(&recorded.inputs, &self.inputs));
-        let split =
-            |s: &Option<SplitRecord>| s.as_ref().map_or("a whole run".into(), |s| s.to_string());
         differ(
             &mut out,
             "split",
-            split(&recorded.shard),
-            split(&self.shard),
+            SplitRecord::describe(recorded.shard.as_ref()),
+            SplitRecord::describe(self.shard.as_ref()),
         );
         out
     }

@@ -121,16 +121,12 @@ pub fn join(shards: &[PathBuf]) -> Result<Joined, EvalError> {
                     _ => false,
                 };
                 if !same_split {
-                    let describe = |s: &Option<SplitRecord>| {
-                        s.as_ref()
-                            .map_or("a whole run".to_string(), |s| s.to_string())
-                    };
                     return Err(EvalError::Argument(format!(
                         "{} ({}) and {} ({}) are not shards of one split",
                         base_dir.display(),
-                        describe(a),
+                        SplitRecord::describe(a.as_ref()),
                         dir.display(),
-                        describe(b)
+                        SplitRecord::describe(b.as_ref())
                     )));
                 }
             }
@@ -256,7 +252,6 @@ impl Joined {
                 .iter()
                 .map(|(_, d)| d.display().to_string())
                 .collect();
-            dirs.dedup();
             dirs.sort();
             dirs.dedup();
             parts.push(format!(

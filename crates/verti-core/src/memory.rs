@@ -3,8 +3,14 @@
 //! instead of aborting on a failed allocation hours in (Rust aborts on allocation failure).
 
 /// The bytes this process may use: the smaller of its address-space limit (`ulimit -v`) and
-/// the machine's physical memory; `None` where neither can be read (not Linux).
+/// the machine's physical memory; `None` where neither can be read (not Linux). Read once per
+/// process: systems are built once per trial, and neither figure changes while it runs.
 pub fn usable_bytes() -> Option<u64> {
+    static USABLE: std::sync::OnceLock<Option<u64>> = std::sync::OnceLock::new();
+    *USABLE.get_or_init(read_usable_bytes)
+}
+
+fn read_usable_bytes() -> Option<u64> {
     let limit = std::fs::read_to_string("/proc/self/limits")
         .ok()
         .and_then(|t| address_space_limit(&t));

@@ -21,15 +21,12 @@ pub fn card_files(card: &Path) -> Result<Vec<PathBuf>, String> {
 }
 
 /// [`card_files`] of every non-empty path parameter of `params` (each a model card): what a
-/// system with card parameters lists as its inputs (`Factory::inputs`).
+/// system with card parameters lists as its inputs (`Factory::inputs`; a file two cards share
+/// is listed twice, and recorded once).
 pub fn cards_in(params: &verti_core::params::Params) -> Result<Vec<PathBuf>, String> {
     let mut out = Vec::new();
     for card in verti_core::registry::path_params(params) {
-        for f in card_files(&card)? {
-            if !out.contains(&f) {
-                out.push(f);
-            }
-        }
+        out.extend(card_files(&card)?);
     }
     Ok(out)
 }

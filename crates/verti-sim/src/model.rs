@@ -98,6 +98,9 @@ pub(crate) struct Model {
     pub friction_speed: f64,
     /// Bounding radius of the vehicle around its centre of mass, plus a margin \[m\].
     pub reach: f64,
+    /// How far below a soil surface the chassis meets a floor: one (largest) wheel diameter
+    /// (soil itself does not hold the chassis, see `contact::body`) \[m\].
+    pub soil_floor: f64,
     pub driven_wheels: usize,
     /// Distance from the first steered axle to the mean of the unsteered ones (Ackermann).
     pub wheelbase: f64,
@@ -231,6 +234,7 @@ impl Model {
         let body_stiffness = 0.25 * total_mass * omega_body * omega_body;
         let body_damping = 2.0 * 0.5 * (body_stiffness * 0.25 * total_mass).sqrt();
         let reach = reach * 1.1 + 0.2 * scale;
+        let soil_floor = 2.0 * wheels.iter().map(|w| w.radius).fold(0.0, f64::max);
         let wheelbase = wheels
             .iter()
             .find(|w| w.steered)
@@ -255,6 +259,7 @@ impl Model {
             body_damping,
             friction_speed: 0.05 * scale.sqrt(),
             reach,
+            soil_floor,
             driven_wheels,
             wheelbase,
         }

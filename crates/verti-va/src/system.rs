@@ -73,6 +73,12 @@ pub struct VaDriver {
     held: Action,
 }
 
+/// The card of world `world` under a `model_per_world` pattern: `{world}` replaced by the
+/// world's index in three digits (001, 002, ...).
+fn card_for_world(pattern: &str, world: u32) -> String {
+    pattern.replace("{world}", &format!("{world:03}"))
+}
+
 /// Models loaded for `{world}` paths, shared by the trials of a process.
 fn per_world_model(path: &str) -> Result<Arc<VaModel>, String> {
     static CACHE: OnceLock<Mutex<HashMap<String, Arc<VaModel>>>> = OnceLock::new();
@@ -151,7 +157,7 @@ impl MobilitySystem for VaDriver {
         self.acts = 0;
         if let Ok(mut a) = self.adapter.lock() {
             if let Some(pattern) = &self.per_world {
-                let path = pattern.replace("{world}", &format!("{:03}", task.id.world));
+                let path = card_for_world(pattern, task.id.world);
                 match per_world_model(&path) {
                     Ok(m) if m.card.method != crate::Method::Va && a.mode() != AdaptMode::None => {
                         self.failure = Some(format!(
@@ -287,7 +293,7 @@ impl Factory<dyn MobilitySystem> for VaSystem {
         let pattern = p.str("model_per_world");
         if !pattern.is_empty() {
             for world in worlds {
-                let card = pattern.replace("{world}", &format!("{world:03}"));
+                let card = card_for_world(pattern, *world);
                 let card = Path::new(&card);
                 if !card.is_file() {
                     return Err(format!(
@@ -295,11 +301,7 @@ impl Factory<dyn MobilitySystem> for VaSystem {
                         card.display()
                     ));
                 }
-                for f in verti_nn::files::card_files(card)? {
-                    if !files.contains(&f) {
-                        files.push(f);
-                    }
-                }
+                files.extend(verti_nn::files::card_files(card)?);
             }
         }
         Ok(files)

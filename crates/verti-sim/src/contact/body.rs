@@ -67,14 +67,6 @@ pub(crate) fn body_contacts(
     let box_bound = terrain.bound.max_in(x0, y0, x1, y1);
     if z0 < box_bound {
         let patches = world.patches.patches();
-        // Soil does not hold the chassis up: in Chrono's SCM only the wheels (the bodies with
-        // an active domain) meet the soil, and the chassis passes through it. Holding it at
-        // the undeformed surface instead left verti's HMMWV high-centred on snow wherever its
-        // wheels sank 0.2-0.4 m, stuck where Chrono's drives on (issue 34). A floor one wheel
-        // diameter below the surface remains, which no upright vehicle reaches while its
-        // wheels carry it: it keeps a capsized vehicle from falling through the map, as
-        // Chrono's can (a reference artifact, not physics).
-        let soil_floor = 2.0 * model.wheels.iter().map(|w| w.radius).fold(0.0, f64::max);
         // ground heights under the bottom points, where sampled (the belly pass reuses them)
         let mut bottom_h = [f64::NAN; 9];
         for (k, p) in pts.iter().enumerate() {
@@ -90,8 +82,15 @@ pub(crate) fn body_contacts(
                 continue;
             }
             let surface = &patches[terrain.ground.patch_index(p.x, p.y)].surface;
+            // Soil does not hold the chassis up: in Chrono's SCM only the wheels (the bodies with
+            // an active domain) meet the soil, and the chassis passes through it. Holding it at
+            // the undeformed surface instead left verti's HMMWV high-centred on snow wherever its
+            // wheels sank 0.2-0.4 m, stuck where Chrono's drives on (issue 34). A floor one wheel
+            // diameter below the surface remains, which no upright vehicle reaches while its
+            // wheels carry it: it keeps a capsized vehicle from falling through the map, as
+            // Chrono's can (a reference artifact, not physics).
             let h = match surface {
-                verti_world::Surface::Deformable { .. } => h - soil_floor,
+                verti_world::Surface::Deformable { .. } => h - model.soil_floor,
                 verti_world::Surface::Rigid { .. } => h,
             };
             if h <= p.z {

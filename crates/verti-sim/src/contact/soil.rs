@@ -27,6 +27,8 @@ pub(crate) fn soil_contact(
     let patches = terrain.world.patches.patches();
     let ground = &terrain.ground;
     let (hub, axle, v_hub, up) = (kin.hub, kin.axle, kin.hub_velocity, kin.up);
+    // the wheel body's angular velocity: the chassis' and the spin (for the tread's speed)
+    let wheel_omega = kin.chassis_omega + axle * kin.spin;
     let r = m.radius;
     let delta = layout.delta;
     let area = delta * delta;
@@ -127,7 +129,6 @@ pub(crate) fn soil_contact(
             // translation alone until issue 34: its HMMWV then sank deeper at speed than
             // Chrono's and stopped on snow where Chrono's drives on; snow agreement with the
             // reference went from 33 % to 60 % with this alone.)
-            let wheel_omega = kin.chassis_omega + axle * kin.spin;
             let v_point = v_hub + wheel_omega.cross(arm);
             sigma -= v_point.dot(normal) * soil.damping;
             let fnode = normal * (sigma * area);
