@@ -60,11 +60,17 @@ fn main() {
     let world = Arc::new(world);
     let spec = vehicles::builtin("hmmwv").unwrap();
     let sim = Sim::new(&world, &spec).unwrap();
-    let mut st = sim.state_at(StartPose::new(-55.0, 0.0, 0.0)).unwrap();
+    // VERTI_PROBE_DROP=1: the reference's start, 1 m above the ground (throttle from t = 0)
+    let start = StartPose::new(-55.0, 0.0, 0.0);
+    let mut st = if std::env::var_os("VERTI_PROBE_DROP").is_some() {
+        sim.state_dropped(start, 1.0).unwrap()
+    } else {
+        sim.state_at(start).unwrap()
+    };
     let dt = 0.005;
     let mut steer = 0.0f64;
     println!(
-        "t,x,y,z,roll,pitch,yaw,v,throttle,sinkage_fl,sinkage_fr,sinkage_rl,sinkage_rr,fz_fl,fz_fr,fz_rl,fz_rr"
+        "t,x,y,z,roll,pitch,yaw,v,throttle,sinkage_fl,sinkage_fr,sinkage_rl,sinkage_rr,fz_fl,fz_fr,fz_rl,fz_rr,gear,engine_torque,wheel_torque,omega_fl,omega_fr,omega_rl,omega_rr,fx_fl,fx_fr,fx_rl,fx_rr"
     );
     let steps = (duration / dt).round() as usize;
     for k in 0..steps {
@@ -81,12 +87,20 @@ fn main() {
             eprintln!("error {e}");
             break;
         }
-        if (k + 1) % 20 == 0 {
+        if (k + 1)
+            % std::env::var("VERTI_PROBE_EVERY")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(20)
+            == 0
+        {
             let p = st.com_position();
             let (r, pi, y) = st.euler();
             let w = st.wheels();
+            let (_, engine_torque) = st.engine();
+            let ratio = spec.powertrain.gears[st.gear()] * spec.powertrain.final_drive;
             println!(
-                "{:.2},{:.3},{:.3},{:.3},{:.2},{:.2},{:.2},{:.3},{:.3},{:.4},{:.4},{:.4},{:.4},{:.0},{:.0},{:.0},{:.0}",
+                "{:.2},{:.3},{:.3},{:.3},{:.2},{:.2},{:.2},{:.3},{:.3},{:.4},{:.4},{:.4},{:.4},{:.0},{:.0},{:.0},{:.0},{},{:.1},{:.0},{:.3},{:.3},{:.3},{:.3},{:.0},{:.0},{:.0},{:.0}",
                 st.time(),
                 p.x,
                 p.y,
@@ -104,6 +118,17 @@ fn main() {
                 w[1].normal_force,
                 w[2].normal_force,
                 w[3].normal_force,
+                st.gear(),
+                engine_torque,
+                engine_torque / ratio,
+                w[0].spin_rate,
+                w[1].spin_rate,
+                w[2].spin_rate,
+                w[3].spin_rate,
+                w[0].long_force,
+                w[1].long_force,
+                w[2].long_force,
+                w[3].long_force,
             );
         }
     }
