@@ -6,12 +6,10 @@
 //! driven wheels' mean speed through the gear and final-drive ratios.
 
 use crate::friction::{CoulombTyre, LongTyre};
-use crate::math::soft_sign;
+use crate::math::{RPM_TO_RAD_S, soft_sign};
 use crate::model::{Model, WheelModel};
 use crate::spec::{MAX_WHEELS, PowertrainSpec, SteeringKind, VehicleSpec};
 use crate::state::{Controls, SimState};
-
-pub(crate) const RPM_TO_RAD_S: f64 = std::f64::consts::PI / 30.0;
 
 // ---- steering ----
 

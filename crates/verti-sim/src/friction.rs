@@ -14,8 +14,7 @@
 //! * Soil: [`soil_tan_phi`] and [`soil_shear_strength`] (Mohr–Coulomb) per node.
 //! * Chassis: [`body_friction`], regularised Coulomb at each body contact point.
 
-use crate::contact::rigid::RigidContact;
-use crate::contact::{WheelContact, WheelKinematics};
+use crate::contact::{RigidContact, WheelContact, WheelKinematics};
 use crate::math::soft_sign;
 use crate::model::WheelModel;
 use crate::spec::TyreSpec;

@@ -1,4 +1,9 @@
-//! Small numeric helpers the inner loops use instead of library calls.
+//! Small numeric helpers the inner loops use instead of library calls, and unit conversions.
+//! Depends on nothing, so any file may use it.
+
+/// rpm to rad/s. Here rather than in `drivetrain` (its main user) because `state` reports
+/// the engine speed in rpm and sits below the drivetrain.
+pub(crate) const RPM_TO_RAD_S: f64 = std::f64::consts::PI / 30.0;
 
 /// x / sqrt(1 + x²): a smooth sign without a transcendental call.
 #[inline]

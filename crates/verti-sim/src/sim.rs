@@ -176,3 +176,24 @@ impl Sim {
         e
     }
 }
+
+/// State methods that need the `Sim`: they live here, not in `state.rs`, so that the plain
+/// state types stay below everything that uses them.
+impl SimState {
+    /// Sets the chassis velocity (world, m/s) and keeps everything else; for tests and planners
+    /// that start from a moving state. Wheels are spun up to roll without slip.
+    pub fn set_velocity(&mut self, sim: &Sim, velocity_world: Vec3) {
+        self.velocity = velocity_world;
+        let forward = self.orientation.rotate(Vec3::X).dot(velocity_world);
+        let model = &sim.model;
+        for (g, grp) in model.groups.iter().enumerate() {
+            let r = grp
+                .wheels
+                .iter()
+                .map(|&w| model.wheels[w].radius)
+                .sum::<f64>()
+                / grp.wheels.len() as f64;
+            self.group_spin[g] = forward / r;
+        }
+    }
+}

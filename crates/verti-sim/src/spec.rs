@@ -7,8 +7,6 @@
 
 use crate::error::SpecError;
 use serde::{Deserialize, Serialize};
-use std::fmt::Write as _;
-use std::path::Path;
 
 /// Most wheels (or road wheels) a vehicle may have; keeps per-step work bounded.
 pub const MAX_WHEELS: usize = 16;
@@ -262,6 +260,9 @@ pub struct TrackSpec {
     pub track_mass: f64,
 }
 
+// `VehicleSpec::from_file` and `VehicleSpec::summary` are in `vehicles.rs`: both compare the
+// vehicle with the built-ins (a user file may not reuse a built-in's name; a summary of a
+// built-in tells what it stands for), and the built-ins are specs, so `spec` stays below them.
 impl VehicleSpec {
     /// Parses and validates a vehicle from YAML text. `origin` names the source in errors,
     /// which name the field by its path (``ORIGIN: field `chassis.mass` is missing``).
@@ -291,48 +292,6 @@ impl VehicleSpec {
         let spec: VehicleSpec = serde_norway::from_str(text)
             .map_err(|e| parse_error(verti_core::messages::explain_serde_error(&e.to_string())))?;
         spec.validate(origin)?;
-        Ok(spec)
-    }
-
-    /// Reads a user vehicle file.
-    pub fn from_file(path: impl AsRef<Path>) -> Result<VehicleSpec, SpecError> {
-        let path = path.as_ref();
-        let text = verti_world::yaml::read_yaml_bounded(
-            path,
-            &verti_world::yaml::YamlLimits::DEFAULT,
-            "a vehicle file",
-        )
-        .map_err(|e| match e {
-            verti_world::WorldError::Io { path, source } => SpecError::Io { path, source },
-            verti_world::WorldError::Invalid {
-                path,
-                field,
-                problem,
-            } => SpecError::Invalid {
-                origin: path.display().to_string(),
-                field,
-                problem,
-            },
-            verti_world::WorldError::Argument(problem) => SpecError::Parse {
-                origin: path.display().to_string(),
-                message: problem,
-            },
-        })?;
-        let spec = Self::from_yaml_str(&text, &path.display().to_string())?;
-        // results record vehicles by name: a different vehicle under a built-in's name would be
-        // taken for the built-in (an exact copy of a built-in is fine)
-        if let Ok(builtin) = crate::vehicles::builtin(&spec.name)
-            && builtin != spec
-        {
-            return Err(SpecError::Invalid {
-                origin: path.display().to_string(),
-                field: "name".into(),
-                problem: format!(
-                    "`{}` is the name of a built-in vehicle, and this one differs from it: give it a name of its own",
-                    spec.name
-                ),
-            });
-        }
         Ok(spec)
     }
 
@@ -641,134 +600,4 @@ impl VehicleSpec {
         }
         Ok(())
     }
-
-    /// A human-readable description for `verti vehicle show NAME`.
-    pub fn summary(&self) -> String {
-        let mut s = String::new();
-        let _ = writeln!(s, "{} — {}", self.name, self.description);
-        let _ = writeln!(
-            s,
-            "  scale            {}",
-            verti_world::scale::scale_label(self.scale)
-        );
-        let _ = writeln!(
-            s,
-            "  mass             {:.2} kg total ({:.2} kg sprung{}), inertia {:?} kg m²",
-            self.total_mass(),
-            self.chassis.mass + self.track.map_or(0.0, |t| 2.0 * t.track_mass),
-            if self.is_tracked() {
-                ", tracks included"
-            } else {
-                ""
-            },
-            self.chassis.inertia
-        );
-        let _ = writeln!(
-            s,
-            "  wheelbase        {:.3} m, {} axles, {} wheels{}",
-            self.wheelbase(),
-            self.axles.len(),
-            self.wheel_count(),
-            if self.is_tracked() {
-                " (road wheels on tracks)"
-            } else {
-                ""
-            }
-        );
-        for (i, a) in self.axles.iter().enumerate() {
-            let _ = writeln!(
-                s,
-                "  axle {i}: x {:+.3} m, track {:.3} m, tyre r {:.3} w {:.3} m, spring {:.0} N/m, damper {:.0} N s/m{}{}",
-                a.x,
-                a.track,
-                a.wheel.radius,
-                a.wheel.width,
-                a.suspension.stiffness,
-                a.suspension.damping,
-                if a.steered { ", steered" } else { "" },
-                if a.driven { ", driven" } else { "" }
-            );
-            if let Some(sa) = &a.solid_axle {
-                let _ = writeln!(
-                    s,
-                    "          solid axle: springs {:.3} m apart, dampers {:.3} m apart (roll rate {:.0} % of heave)",
-                    sa.spring_track,
-                    sa.damper_track,
-                    100.0 * (sa.spring_track / a.track).powi(2)
-                );
-            }
-        }
-        match self.steering.kind {
-            SteeringKind::Ackermann => {
-                let _ = writeln!(
-                    s,
-                    "  steering         Ackermann, max {:.1}°, {:.0}°/s",
-                    self.steering.max_angle_deg, self.steering.rate_deg_per_s
-                );
-            }
-            SteeringKind::Skid => {
-                let _ = writeln!(
-                    s,
-                    "  steering         skid, inner-side brake {:.0} N m per wheel",
-                    self.steering.skid_brake_torque
-                );
-            }
-        }
-        let p = &self.powertrain;
-        let peak = p
-            .full_throttle
-            .iter()
-            .map(|pt| pt[1])
-            .fold(f64::NEG_INFINITY, f64::max);
-        let drive = if self.is_tracked() {
-            "tracks (one spin per side)".to_string()
-        } else {
-            format!(
-                "differentials axle {:?} / central {:?}",
-                p.axle_differential, p.central_differential
-            )
-        };
-        let _ = writeln!(
-            s,
-            "  powertrain       peak {} N m, max {:.0} rpm, gears {:?}, final drive {}, {}",
-            significant(peak, 4),
-            p.max_speed_rpm,
-            p.gears,
-            p.final_drive,
-            drive
-        );
-        let _ = writeln!(
-            s,
-            "  tyre             {}μ {}, Cz {:.3e} N/m, rolling resistance {}",
-            match self.tyre.model {
-                TyreModel::Handling => "",
-                TyreModel::Rigid => "rigid cylinder, ",
-            },
-            self.tyre.friction,
-            self.tyre.radial_stiffness,
-            self.tyre.rolling_resistance
-        );
-        let _ = write!(s, "  internal step    {} ms", self.internal_step * 1e3);
-        // a built-in (unchanged): what it stands for and where its numbers come from
-        if let Some(m) = crate::vehicles::mechanisms(&self.name)
-            && crate::vehicles::builtin(&self.name).is_ok_and(|b| b == *self)
-        {
-            let _ = write!(
-                s,
-                "\n  chassis          {}\n  suspension       {}\n  steering         {}\n  sources          {}; `verti vehicle show {} --yaml` cites each number",
-                m.chassis, m.suspension, m.steering, m.source, self.name
-            );
-        }
-        s
-    }
-}
-
-/// `x` with about `digits` significant digits (no exponent), for summaries of vehicles from
-/// 1/10 scale (0.06 N m motors) to trucks (1600 N m engines).
-fn significant(x: f64, digits: i32) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0) as usize;
-    format!("{x:.decimals$}")
 }

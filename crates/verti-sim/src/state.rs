@@ -2,9 +2,8 @@
 //! vehicle starts ([`StartPose`]), poses ([`Pose`]) and everything that changes during a
 //! simulation ([`SimState`], with its per-wheel [`WheelState`] and [`ContactInfo`]).
 
-use crate::drivetrain::RPM_TO_RAD_S;
 use crate::error::SimError;
-use crate::sim::Sim;
+use crate::math::RPM_TO_RAD_S;
 use crate::soil::SoilState;
 use serde::{Deserialize, Serialize};
 use verti_core::{Quat, Vec3};
@@ -14,7 +13,7 @@ const POSITION_LIMIT: f64 = 1.0e5;
 /// Any speed above this (m/s at full scale) is a blow-up.
 const SPEED_LIMIT: f64 = 500.0;
 
-/// Driver inputs, held constant over one [`Sim::step`].
+/// Driver inputs, held constant over one [`Sim::step`](crate::Sim::step).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Controls {
     /// \[0, 1\]
@@ -61,7 +60,7 @@ impl Controls {
 }
 
 /// Where a vehicle is set down: a spot on the map \[m\] and a heading \[rad\] (counter-clockwise
-/// from +x). [`Sim::state_at`] seats the vehicle there on the terrain.
+/// from +x). [`Sim::state_at`](crate::Sim::state_at) seats the vehicle there on the terrain.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StartPose {
     pub x: f64,
@@ -236,22 +235,8 @@ impl SimState {
         // body z axis pointing below the horizon
         self.orientation.rotate(Vec3::Z).z < 0.0
     }
-    /// Sets the chassis velocity (world, m/s) and keeps everything else; for tests and planners
-    /// that start from a moving state. Wheels are spun up to roll without slip.
-    pub fn set_velocity(&mut self, sim: &Sim, velocity_world: Vec3) {
-        self.velocity = velocity_world;
-        let forward = self.orientation.rotate(Vec3::X).dot(velocity_world);
-        let model = &sim.model;
-        for (g, grp) in model.groups.iter().enumerate() {
-            let r = grp
-                .wheels
-                .iter()
-                .map(|&w| model.wheels[w].radius)
-                .sum::<f64>()
-                / grp.wheels.len() as f64;
-            self.group_spin[g] = forward / r;
-        }
-    }
+    // `set_velocity` is in `sim.rs`: it reads the wheel radii from the `Sim`, which sits above
+    // this plain data.
     /// Sets the body-frame angular velocity \[rad/s\].
     pub fn set_angular_velocity_body(&mut self, omega: Vec3) {
         self.omega = omega;

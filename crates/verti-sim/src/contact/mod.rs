@@ -92,6 +92,23 @@ impl WheelContact {
     }
 }
 
+/// What the rigid tyre's friction needs beyond the summed normal force (the second result of
+/// `rigid::rigid_wheel_contact`). Here beside [`WheelContact`], not in `rigid`, because
+/// `friction` reads both and sits below the contact stages.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct RigidContact {
+    /// Load-weighted contact point relative to the hub (world) \[m\]. Each contact's point
+    /// is on the cylinder (the wheel's point deepest in what it touches), so on one contact
+    /// the lever about the axle is the radius itself: the penetration is the penalty method's
+    /// stand-in for a rigid contact, not a loaded radius, and a load-dependent lever would
+    /// make the locked axles of a 4x4 fight each other.
+    pub arm: Vec3,
+    /// Coulomb limit Σ μ·N over the rigid contacts \[N\], μ = min(tyre μ, surface μ).
+    pub friction_limit: f64,
+    /// Moment of the normal forces about the hub without its part along the axle \[N m\].
+    pub moment: Vec3,
+}
+
 /// The broad phase of a wheel (radius `r`, half width `half_width`, hub at `hub`) against
 /// obstacle `k`: `None` when the obstacle is out of reach by its planar circle, its height
 /// range or its bounding sphere (cheapest test first), else its fast geometry. Shared by both

@@ -28,9 +28,8 @@
 //! Every contact's normal force acts at the hub; its moment about the hub, less the part along
 //! the axle (zero for a cylinder's radial normals), reaches the chassis through the bearing.
 
-use super::soil::soil_contact;
-use super::wheel::soil_as_rigid;
-use super::{WheelContact, WheelKinematics};
+use super::soil::{soil_as_rigid, soil_contact};
+use super::{RigidContact, WheelContact, WheelKinematics};
 use crate::friction::{OBSTACLE_FRICTION, surface_mu};
 use crate::model::WheelModel;
 use crate::soil::SoilState;
@@ -50,21 +49,6 @@ const ARC: [(f64, f64); 5] = [
 /// Most rock faces the exact circle–polygon test handles (generated rocks have 17, imported
 /// ones 6); a rock with more meets the wheel at its point nearest the rock instead.
 const MAX_FACES: usize = 64;
-
-/// What the rigid tyre's friction needs beyond the summed normal force.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct RigidContact {
-    /// Load-weighted contact point relative to the hub (world) \[m\]. Each contact's point
-    /// is on the cylinder (the wheel's point deepest in what it touches), so on one contact
-    /// the lever about the axle is the radius itself: the penetration is the penalty method's
-    /// stand-in for a rigid contact, not a loaded radius, and a load-dependent lever would
-    /// make the locked axles of a 4x4 fight each other.
-    pub arm: Vec3,
-    /// Coulomb limit Σ μ·N over the rigid contacts \[N\], μ = min(tyre μ, surface μ).
-    pub friction_limit: f64,
-    /// Moment of the normal forces about the hub without its part along the axle \[N m\].
-    pub moment: Vec3,
-}
 
 /// Sums one contact into the wheel's contact.
 struct Sum<'a> {

@@ -3,7 +3,6 @@
 //! Mohr–Coulomb shear limit of the patch (the storage and Bekker's law are in
 //! [`crate::soil`]).
 
-use super::wheel::MAX_SOIL_NODES_PER_WHEEL;
 use super::{WheelContact, WheelKinematics};
 use crate::friction::{soil_shear_strength, soil_tan_phi};
 use crate::math::{fast_ceil, fast_floor};
@@ -12,6 +11,26 @@ use crate::soil::{SoilLayout, SoilState, bekker_pressure, bekker_slope};
 use crate::terrain::Terrain;
 use verti_core::Vec3;
 use verti_world::Surface;
+
+// The cap and `soil_as_rigid` (whether the soil grid acts under a wheel at all) are this
+// stage's limits; both tyre models (`wheel`, `rigid`) ask them before handing a wheel here.
+
+/// Safety cap on soil nodes visited per wheel per step.
+pub(crate) const MAX_SOIL_NODES_PER_WHEEL: usize = 4096;
+
+/// True when the soil grid cannot resolve this wheel, so the soil acts as rigid ground under
+/// it: a tread narrower than the node spacing (a 1/10 vehicle on a full-scale world) could
+/// fall between nodes, and a wheel far too big for the grid would visit thousands of nodes.
+#[inline]
+pub(crate) fn soil_as_rigid(terrain: &Terrain, m: &WheelModel) -> bool {
+    let r = m.radius;
+    terrain.soil.is_none_or(|l| {
+        let span = (2.0 * r + 2.0 * m.half_width) / l.delta + 2.0;
+        span * span > MAX_SOIL_NODES_PER_WHEEL as f64
+            || 2.0 * m.half_width < l.delta
+            || r < 1.5 * l.delta
+    })
+}
 
 /// Adds the soil under one wheel to its contact `c`. `b`: the size of the wheel's last soil
 /// patch (Bekker's K_c/b term).

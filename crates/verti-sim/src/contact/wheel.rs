@@ -1,6 +1,7 @@
 //! One wheel against rigid ground and obstacles: a radial spring-damper tyre (stiffer once it
 //! bottoms out on the rim) at the deepest of a few points on the wheel, plus the soil under it.
 
+use super::soil::soil_as_rigid;
 use super::{WheelContact, WheelKinematics};
 use crate::friction::{OBSTACLE_FRICTION, surface_mu, tyre_mu_scale};
 use crate::model::WheelModel;
@@ -8,23 +9,6 @@ use crate::soil::SoilState;
 use crate::spec::TyreSpec;
 use crate::terrain::Terrain;
 use verti_core::Vec3;
-
-/// Safety cap on soil nodes visited per wheel per step.
-pub(crate) const MAX_SOIL_NODES_PER_WHEEL: usize = 4096;
-
-/// True when the soil grid cannot resolve this wheel, so the soil acts as rigid ground under
-/// it: a tread narrower than the node spacing (a 1/10 vehicle on a full-scale world) could
-/// fall between nodes, and a wheel far too big for the grid would visit thousands of nodes.
-#[inline]
-pub(crate) fn soil_as_rigid(terrain: &Terrain, m: &WheelModel) -> bool {
-    let r = m.radius;
-    terrain.soil.is_none_or(|l| {
-        let span = (2.0 * r + 2.0 * m.half_width) / l.delta + 2.0;
-        span * span > MAX_SOIL_NODES_PER_WHEEL as f64
-            || 2.0 * m.half_width < l.delta
-            || r < 1.5 * l.delta
-    })
-}
 
 /// Contact of one wheel with rigid terrain, obstacles (indices `near`) and soil. Writes the
 /// soil's plastic memory under the wheel. `soil_b`: the size of the wheel's last soil patch.
