@@ -11,7 +11,6 @@ use crate::episode::{EpisodeConfig, TrialResult, run_episode};
 use crate::identity::RunRecord;
 use crate::system::MobilitySystem;
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -20,30 +19,17 @@ use std::sync::{Arc, Mutex};
 use verti_sim::VehicleSpec;
 use verti_world::{TaskId, World};
 
+// `EvalError` (in `eval_error`) and `RunInfo` (in `identity`) are defined below this module:
+// `identity` reads and checks `run.json` with them, and this module records runs through
+// `identity`, so defining them here would make the two import each other. Re-exported here,
+// their long-standing path.
+pub use crate::eval_error::EvalError;
+pub use crate::identity::RunInfo;
+
 pub const RESULTS_FILE: &str = "results.jsonl";
 pub const RUN_FILE: &str = "run.json";
 /// Subdirectory of a run's per-step logs (one Parquet file per trial).
 pub const STEPS_DIR: &str = "steps";
-
-#[derive(Debug, thiserror::Error)]
-pub enum EvalError {
-    #[error("{0}")]
-    Argument(String),
-    #[error("{path}: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("{path}: line {line}: {problem}")]
-    Corrupt {
-        path: PathBuf,
-        line: usize,
-        problem: String,
-    },
-    /// The run was cancelled (`EvalSetup::cancel`); the results recorded before it are kept.
-    #[error("the evaluation was cancelled")]
-    Cancelled,
-}
 
 fn io(path: &Path) -> impl Fn(std::io::Error) -> EvalError + '_ {
     move |source| EvalError::Io {
@@ -118,24 +104,6 @@ pub fn parse_tasks(spec: &str) -> Result<Vec<u32>, EvalError> {
         out.extend(a..=b);
     }
     Ok(out.into_iter().collect())
-}
-
-/// What a run is, as its caller describes it; `run.json` holds it with the content digests
-/// of the worlds and vehicle ([`crate::identity::RunRecord`]) and is compared on resume.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RunInfo {
-    pub system: String,
-    /// Every parameter of the system (defaults included), resolved by its registry. Older
-    /// `run.json` files hold only the parameters given, as `[name, number]` pairs; they still
-    /// resume (see [`RunRecord::differences`]).
-    pub params: verti_core::params::Params,
-    pub vehicle: String,
-    pub worlds: String,
-    /// World scale the set was generated or imported at.
-    pub scale: f64,
-    pub rules: crate::episode::Rules,
-    pub seed: u64,
-    pub max_time: f64,
 }
 
 /// Resolves the selected task numbers against a set: all tasks of the set when `selection` is

@@ -6,7 +6,7 @@
 //! trained on some selection of features can therefore be evaluated on exactly the same inputs
 //! under `verti eval`, and a new feature appears everywhere at once.
 
-use crate::observation::Pose6;
+use crate::pose::Pose6;
 use verti_core::Vec3;
 use verti_sim::{Controls, SimState};
 

@@ -8,7 +8,7 @@
 //! differs is refused with the settings that differ, one by one.
 
 use crate::episode::StartMode;
-use crate::eval::{EvalError, RunInfo};
+use crate::eval_error::EvalError;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::sync::Arc;
@@ -139,6 +139,24 @@ impl std::fmt::Display for SplitRecord {
             self.index, self.count, self.of
         )
     }
+}
+
+/// What a run is, as its caller describes it; `run.json` holds it with the content digests
+/// of the worlds and vehicle ([`RunRecord`]) and is compared on resume.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunInfo {
+    pub system: String,
+    /// Every parameter of the system (defaults included), resolved by its registry. Older
+    /// `run.json` files hold only the parameters given, as `[name, number]` pairs; they still
+    /// resume (see [`RunRecord::differences`]).
+    pub params: verti_core::params::Params,
+    pub vehicle: String,
+    pub worlds: String,
+    /// World scale the set was generated or imported at.
+    pub scale: f64,
+    pub rules: crate::episode::Rules,
+    pub seed: u64,
+    pub max_time: f64,
 }
 
 /// `OUT/run.json`: the run's settings as given, what they resolved to by content, and the

@@ -6,11 +6,15 @@
 //!   [`Action`]; they never touch simulator internals. A [`SystemRegistry`] builds them by
 //!   name from typed [`Params`].
 //! * [`observation`]: ground-truth observations with lazily computed, heading-aligned map crops.
+//!   The oracle's privileged view of the running trial reaches it through one explicit seam
+//!   (`privileged`), so observations do not depend on the trial.
 //! * [`trial`]: [`Trial`], one vehicle on one task as one value that is stepped, cloned
 //!   (branched) and finished; the only place the inner loop (speed controller, physics,
 //!   metrics, rules) exists.
-//! * [`episode`]: the paper's success and failure rules (or the reference code's, with
-//!   `Rules::VertiBench`), the trial result, and [`run_episode`]: a system driving a `Trial`.
+//! * [`episode`]: [`run_episode`], a system driving a `Trial`, and (re-exported from the
+//!   private `rules` and `result`, which sit below the trial that applies them) the paper's
+//!   success and failure rules (or the reference code's, with `Rules::VertiBench`) and the
+//!   trial result.
 //! * [`features`]: the one schema of named state features (step logs, state vectors).
 //! * [`path`]: following the global path (local goal, heading error), for systems and rewards.
 //! * [`metrics`]: per-trial metrics and their aggregation into the paper's Table I and Fig. 6.
@@ -20,6 +24,7 @@
 
 pub mod episode;
 pub mod eval;
+mod eval_error;
 pub mod features;
 pub mod identity;
 pub mod metrics;
@@ -27,8 +32,12 @@ mod nullable;
 pub mod observation;
 pub mod path;
 pub mod perception;
+mod pose;
+mod privileged;
 pub mod replay;
 pub mod report;
+mod result;
+mod rules;
 pub mod shard;
 pub mod speed;
 pub mod system;

@@ -4,15 +4,17 @@
 //! Crops are computed only when a system asks for them, so a system that needs no map pays
 //! nothing for maps.
 //!
-//! An observation made by a running [`Trial`] also carries the trial itself, reachable through
-//! [`Observation::trial`]. That is *privileged*: a system that uses it plans with the true
-//! simulator, which no deployable system has. Only oracle-type systems (the `oracle` of
-//! verti-systems, an expert demonstrator for datasets) may use it; every system of the paper
-//! sees the fields above only.
+//! An observation made by a running [`Trial`](crate::Trial) also carries the trial itself,
+//! reachable through [`Observation::trial`]. That is *privileged*: a system that uses it plans
+//! with the true simulator, which no deployable system has. Only oracle-type systems (the
+//! `oracle` of verti-systems, an expert demonstrator for datasets) may use it; every system of
+//! the paper sees the fields above only. The observation holds it as an opaque view (the seam
+//! of `crate::privileged`), so this module does not depend on the trial (which depends on it):
+//! `Observation::with_trial` and `Observation::trial` are defined in `trial`.
 
 use crate::features::FeatureSource;
 use crate::perception::Sensing;
-use crate::trial::Trial;
+use crate::privileged::PrivilegedView;
 use verti_core::Vec3;
 use verti_sim::Controls;
 use verti_world::World;
@@ -40,17 +42,9 @@ impl<T: Copy> Crop<T> {
     }
 }
 
-/// Chassis pose: position of the reference point and Z-Y-X Euler angles (radians). The
-/// default is the origin, level, facing +x.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Pose6 {
-    pub x: f64,
-    pub y: f64,
-    pub z: f64,
-    pub roll: f64,
-    pub pitch: f64,
-    pub yaw: f64,
-}
+/// The chassis pose (defined in the bottom-layer `crate::pose`, which every module that
+/// speaks of poses imports; re-exported here, where it has always been reachable).
+pub use crate::pose::Pose6;
 
 /// One observation. Borrowed from the episode; valid during one `act` call.
 pub struct Observation<'a> {
@@ -71,8 +65,9 @@ pub struct Observation<'a> {
     /// Length scale of the world.
     pub world_scale: f64,
     vehicle: FeatureSource,
-    /// The trial observed (privileged; see [`Observation::trial`]).
-    trial: Option<&'a Trial>,
+    /// The trial observed (privileged; see [`Observation::trial`]), type-erased so that this
+    /// module need not name the trial (`crate::privileged`).
+    privileged: Option<PrivilegedView<'a>>,
     /// Range limit and latency of map reads under perception noise (None: ideal sensing).
     sensing: Option<Sensing>,
 }
@@ -98,7 +93,7 @@ impl<'a> Observation<'a> {
             global_path,
             world_scale: world.meta.scale,
             vehicle,
-            trial: None,
+            privileged: None,
             sensing: None,
         }
     }
@@ -115,27 +110,23 @@ impl<'a> Observation<'a> {
         self.sensing.as_ref()
     }
 
-    /// This observation with privileged access to `trial`, the running trial it describes
-    /// ([`crate::Trial::observation`] sets it; see [`Observation::trial`]).
-    pub fn with_trial(mut self, trial: &'a Trial) -> Self {
-        self.trial = Some(trial);
+    /// This observation with the privileged view `view` (the running trial it describes;
+    /// `Observation::with_trial` in `trial` sets it).
+    pub(crate) fn with_privileged(mut self, view: PrivilegedView<'a>) -> Self {
+        self.privileged = Some(view);
         self
     }
 
     /// This observation without privileged access (what a system would see outside a trial).
     pub fn without_trial(mut self) -> Self {
-        self.trial = None;
+        self.privileged = None;
         self
     }
 
-    /// **Privileged.** The running trial this observation was made from: the true simulator
-    /// and world, which a system may clone ([`Trial::clone`], [`Trial::branch`]) and step to
-    /// look ahead. Only oracle-type systems (planners with the true simulator, expert
-    /// demonstrators) may use it; a system compared with the paper's must not. `None` where
-    /// no trial exists: observations built by hand ([`Observation::new`], [`test_observation`])
-    /// or for systems outside a trial (e.g. Python).
-    pub fn trial(&self) -> Option<&'a Trial> {
-        self.trial
+    /// The privileged view, if this observation carries one (`Observation::trial` in `trial`
+    /// reads it back as the trial).
+    pub(crate) fn privileged(&self) -> Option<PrivilegedView<'a>> {
+        self.privileged
     }
 
     /// The vehicle's state as named features (the schema of [`crate::features`]).

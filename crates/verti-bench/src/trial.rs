@@ -7,13 +7,14 @@
 //! branching rollouts. The inner loop (speed controller, physics, pose, metrics, termination
 //! rules, step log) therefore exists once.
 
-use crate::episode::{
-    EpisodeConfig, EpisodeLog, Outcome, StartMode, StepRecord, Termination, TrialResult,
-};
 use crate::features::{FeatureSource, STEP_LOG};
 use crate::metrics::{AngleStats, SignalStats};
-use crate::observation::{Observation, Pose6};
+use crate::observation::Observation;
 use crate::perception::Perception;
+use crate::pose::Pose6;
+use crate::privileged::PrivilegedView;
+use crate::result::{EpisodeLog, StepRecord, TrialResult};
+use crate::rules::{EpisodeConfig, Outcome, StartMode, Termination};
 use crate::speed::SpeedController;
 use crate::system::{Action, TaskInfo};
 use std::sync::Arc;
@@ -33,6 +34,29 @@ pub struct StepOutcome {
 
 /// Seed stream of perception noise ("percept" in ASCII), mixed with the run seed and task.
 const PERCEPTION_STREAM: u64 = 0x0070_6572_6365_7074;
+
+/// The oracle's privileged access, defined here rather than in `observation` because the
+/// observation sits below the trial and holds it only as an opaque view (see
+/// `crate::privileged`, the seam): the trial fills the view in, and oracle-type systems read it
+/// back as the trial.
+impl<'a> Observation<'a> {
+    /// This observation with privileged access to `trial`, the running trial it describes
+    /// ([`Trial::observation`] sets it; see [`Observation::trial`]).
+    pub fn with_trial(self, trial: &'a Trial) -> Self {
+        self.with_privileged(PrivilegedView::new(trial))
+    }
+
+    /// **Privileged.** The running trial this observation was made from: the true simulator
+    /// and world, which a system may clone ([`Trial::clone`], [`Trial::branch`]) and step to
+    /// look ahead. Only oracle-type systems (planners with the true simulator, expert
+    /// demonstrators) may use it; a system compared with the paper's must not. `None` where
+    /// no trial exists: observations built by hand ([`Observation::new`],
+    /// [`test_observation`](crate::observation::test_observation)) or for systems outside a
+    /// trial (e.g. Python).
+    pub fn trial(&self) -> Option<&'a Trial> {
+        self.privileged().and_then(|view| view.get::<Trial>())
+    }
+}
 
 /// One trial in progress. Cloning it branches the trial: the clone continues independently
 /// (the world and the simulator model are shared, the state is copied).

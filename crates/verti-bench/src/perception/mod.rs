@@ -20,7 +20,7 @@ pub mod model;
 pub use model::{PRESETS, PerceptionModel};
 
 use crate::features::FeatureSource;
-use crate::observation::Pose6;
+use crate::pose::Pose6;
 use std::sync::Arc;
 use verti_core::Vec3;
 use verti_core::rng::Rng;

@@ -1,51 +1,11 @@
 //! Loading: `results.jsonl` files, or directories holding them, read into trial results
 //! ([`load_results`], [`load_results_from`]).
 
+use super::loaded::{Loaded, LoadedFile, ReportError};
 use crate::episode::TrialResult;
-use crate::eval::{EvalError, RESULTS_FILE, RUN_FILE, read_results};
+use crate::eval::{RESULTS_FILE, RUN_FILE, read_results};
 use crate::identity::RunRecord;
 use std::path::{Path, PathBuf};
-
-/// Why results could not be loaded.
-#[derive(Debug, thiserror::Error)]
-pub enum ReportError {
-    #[error("{}: no such file or directory", .0.display())]
-    NotFound(PathBuf),
-    #[error(
-        "{}: no {RESULTS_FILE} in this directory or its immediate subdirectories",
-        .0.display()
-    )]
-    NoResults(PathBuf),
-    #[error("{}: {source}", path.display())]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    /// Reading or parsing a results file failed (the message names the file and line).
-    #[error(transparent)]
-    Eval(#[from] EvalError),
-    /// The same trials were given twice (one file twice, or two copies of one run).
-    #[error("{0}")]
-    Duplicate(String),
-}
-
-/// One results file that was read.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LoadedFile {
-    pub path: PathBuf,
-    pub trials: usize,
-    /// `false` when a torn last line (a trial in flight when the run was killed) was dropped.
-    pub clean: bool,
-    /// The run's `run.json` (beside a `results.jsonl`), when there is one.
-    pub run: Option<RunRecord>,
-}
-
-/// Results and the files they came from.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Loaded {
-    pub results: Vec<TrialResult>,
-    pub files: Vec<LoadedFile>,
-}
 
 /// The results files a path stands for: a file itself; a directory's `results.jsonl`; or,
 /// for a directory without one (e.g. a folder of runs), the `results.jsonl` of each immediate

@@ -36,7 +36,8 @@
 //! The shared data types (this file) are separate from what computes and writes them:
 //!
 //! * `aggregate`: [`summarize`], trials reduced to the types below.
-//! * `load`: [`load_results`], [`load_results_from`] and their error type.
+//! * `load`: [`load_results`], [`load_results_from`]; `loaded`: what they return and their
+//!   error type (below `load` and `runs`, which both use them).
 //! * `paired`: [`PairedComparison`]s, the sign test between systems on shared tasks.
 //! * `charts`: [`fig6_charts`] and its panel types.
 //! * `tables`: the summary as tables of text cells, shared by both writers.
@@ -50,6 +51,7 @@ mod charts;
 #[cfg(test)]
 mod fixtures;
 mod load;
+mod loaded;
 mod paired;
 mod runs;
 mod tables;
@@ -57,7 +59,8 @@ mod writers;
 
 pub use aggregate::summarize;
 pub use charts::{ChartPanel, ChartSeries, Fig6Metric, fig6_charts};
-pub use load::{Loaded, LoadedFile, ReportError, load_results, load_results_from};
+pub use load::{load_results, load_results_from};
+pub use loaded::{Loaded, LoadedFile, ReportError};
 pub use writers::{html, markdown, system_page, system_page_name};
 
 use crate::episode::TrialResult;

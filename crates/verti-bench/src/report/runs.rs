@@ -4,7 +4,7 @@
 //! a file given twice, or two copies of one run covering the same tasks, are refused instead
 //! of being counted twice.
 
-use super::load::{LoadedFile, ReportError};
+use super::loaded::{LoadedFile, ReportError};
 use crate::episode::TrialResult;
 use crate::identity::RunRecord;
 use std::collections::{BTreeMap, HashMap};
