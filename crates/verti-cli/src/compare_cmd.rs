@@ -2,9 +2,8 @@
 //! `../shared/chrono-reference`) in verti and compares them; writes a page per task and the
 //! summary. The work is done by `verti-compare` and the drawing by `verti-render`.
 
+use crate::cli_common::{CmdResult, load_vehicle};
 use crate::progress::bar;
-use crate::vehicle_cmd::load_vehicle;
-use crate::world_cmd::CmdResult;
 use clap::Args;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};

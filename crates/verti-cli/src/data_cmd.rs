@@ -1,8 +1,7 @@
 //! `verti data generate` and `verti data stats`: the datasets of Verti-Bench §III-G.
 
+use crate::cli_common::{CmdResult, ScaleArg, load_set_checked, load_vehicle};
 use crate::progress::bar;
-use crate::vehicle_cmd::load_vehicle;
-use crate::world_cmd::{CmdResult, ScaleArg, load_set_checked};
 use clap::{Args, Subcommand};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -59,7 +58,7 @@ pub struct GenerateArgs {
     #[arg(long, default_value = "oracle")]
     system: String,
     /// System parameter override, name=value (repeatable).
-    #[arg(long = "param", value_parser = crate::eval_cmd::assignment)]
+    #[arg(long = "param", value_parser = crate::cli_common::assignment)]
     params: Vec<String>,
     /// Length cap of an exploration trial, simulated seconds.
     #[arg(long, default_value_t = MAX_TRIAL_SECONDS)]

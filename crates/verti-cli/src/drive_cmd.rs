@@ -1,9 +1,7 @@
 //! `verti drive`: a person drives one task in real time, watching it live in the browser (or
 //! a system drives while the person watches), recorded as a demonstration dataset.
 
-use crate::eval_cmd::assignment;
-use crate::vehicle_cmd::load_vehicle;
-use crate::world_cmd::{CmdResult, ScaleArg, load_set_checked};
+use crate::cli_common::{CmdResult, ScaleArg, assignment, load_set_checked, load_vehicle};
 use clap::Args;
 use std::io::Write;
 use std::path::{Path, PathBuf};

@@ -1,8 +1,8 @@
 //! `verti systems`, `verti eval`, `verti replay`.
 
+use crate::cli_common::{CmdResult, ScaleArg, assignment, load_set_checked, load_vehicle};
+use crate::outputs::ensure_parent;
 use crate::progress::bar;
-use crate::vehicle_cmd::load_vehicle;
-use crate::world_cmd::{CmdResult, ScaleArg, ensure_parent, load_set_checked};
 use clap::Args;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -15,15 +15,6 @@ use verti_world::World;
 pub fn systems_list() -> CmdResult {
     crate::registries::print_list(crate::registries::systems().list());
     Ok(())
-}
-
-/// `name=value`; the value is read per the parameter's declared type once the system is known.
-pub fn assignment(s: &str) -> Result<String, String> {
-    if s.contains('=') {
-        Ok(s.to_string())
-    } else {
-        Err(format!("parameter `{s}` must look like name=value"))
-    }
 }
 
 fn parse_start(s: &str) -> Result<StartMode, String> {

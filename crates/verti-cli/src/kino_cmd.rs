@@ -30,7 +30,7 @@ pub struct KinoEvalArgs {
 /// The bicycle geometry of the vehicle a dataset was driven with.
 pub fn geometry_of(dir: &Path) -> Result<Geometry, String> {
     let m = verti_data::Manifest::read(dir).map_err(|e| e.to_string())?;
-    let spec = crate::vehicle_cmd::load_vehicle(&m.vehicle)
+    let spec = crate::cli_common::load_vehicle(&m.vehicle)
         .map_err(|e| format!("{}: vehicle {}: {e}", dir.display(), m.vehicle))?;
     Ok(Geometry {
         wheelbase: spec.wheelbase() * m.worlds.scale,

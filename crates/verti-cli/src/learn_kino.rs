@@ -1,6 +1,6 @@
 //! `verti learn kino` (with the `learn` feature): trains a learned kinodynamic model.
 
-use crate::learn_cmd::KinoArgs;
+use crate::learn_args::KinoArgs;
 use crate::progress::bar;
 use std::path::PathBuf;
 use verti_kino::KinoKind;

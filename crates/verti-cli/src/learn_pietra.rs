@@ -9,9 +9,9 @@
 //! files for its progress bar and builds the tables from them, so a killed benchmark resumes
 //! (`--resume`) with every finished run kept.
 
-use crate::learn_cmd::PietraArgs;
+use crate::cli_common::load_vehicle;
+use crate::learn_args::PietraArgs;
 use crate::progress::bar;
-use crate::vehicle_cmd::load_vehicle;
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::io::Write as _;

@@ -1,9 +1,8 @@
 //! `verti learn rl` (with the `learn` feature): trains a driving policy with PPO.
 
-use crate::learn_cmd::{CurvesArgs, RlArgs};
+use crate::cli_common::{load_set_with_progress, load_vehicle};
+use crate::learn_args::{CurvesArgs, RlArgs};
 use crate::progress::bar;
-use crate::vehicle_cmd::load_vehicle;
-use crate::world_cmd::load_set_with_progress;
 use std::path::PathBuf;
 use std::sync::Arc;
 use verti_learn::Device;

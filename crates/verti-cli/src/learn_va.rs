@@ -1,6 +1,6 @@
 //! `verti learn va` (with the `learn` feature): trains VertiAdaptor or one of its baselines.
 
-use crate::learn_cmd::VaArgs;
+use crate::learn_args::VaArgs;
 use crate::progress::bar;
 use std::path::PathBuf;
 use verti_learn::Device;

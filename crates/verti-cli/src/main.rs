@@ -1,10 +1,12 @@
 //! `verti`: the command line of the verti off-road mobility benchmark.
 
+mod cli_common;
 mod compare_cmd;
 mod data_cmd;
 mod drive_cmd;
 mod eval_cmd;
 mod kino_cmd;
+mod learn_args;
 mod learn_cmd;
 #[cfg(feature = "learn")]
 mod learn_kino;

@@ -1,6 +1,6 @@
 //! `verti merge`: joins the run directories of a sharded evaluation (`verti eval --shard i/N`).
 
-use crate::world_cmd::CmdResult;
+use crate::cli_common::CmdResult;
 use clap::Args;
 use std::path::PathBuf;
 

@@ -3,8 +3,9 @@
 //! parent directory (see `verti_core::output`).
 
 use clap::Command;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use verti_core::output::{IMAGE_FORMATS, check_output_dir, check_output_file};
+use verti_world::WorldError;
 
 /// A picture to write: a `.png` file in an existing directory.
 pub fn png_file(text: &str) -> Result<PathBuf, String> {
@@ -26,6 +27,13 @@ pub fn out_dir(text: &str) -> Result<PathBuf, String> {
     let path = PathBuf::from(text);
     check_output_dir(&path)?;
     Ok(path)
+}
+
+/// Checks that an output file can be written: a picture format verti writes, in a directory
+/// that exists. Missing directories are not created (a typo should not grow a tree).
+pub fn ensure_parent(path: &Path) -> Result<(), WorldError> {
+    verti_core::output::check_output_file(path, verti_core::output::IMAGE_FORMATS)
+        .map_err(|problem| WorldError::Argument(format!("{}: {problem}", path.display())))
 }
 
 /// Puts the checks on the output arguments of `verti eval`, `verti replay` and `verti

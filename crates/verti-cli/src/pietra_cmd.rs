@@ -2,8 +2,8 @@
 //! Fig. 7) — risk-aware MPPI over six traversability models at three risk tolerances on the
 //! ten test maps.
 
+use crate::cli_common::load_vehicle;
 use crate::progress::bar;
-use crate::vehicle_cmd::load_vehicle;
 use clap::{Args, Subcommand};
 use std::fmt::Write as _;
 use std::path::PathBuf;

@@ -1,9 +1,8 @@
 //! `verti vehicle ...` and `verti sim ...`
 
+use crate::cli_common::{CmdResult, load_set_with_progress, load_vehicle};
 use crate::progress::bar;
-use crate::world_cmd::{CmdResult, load_set_with_progress};
 use clap::{Args, Subcommand};
-use std::path::Path;
 use std::sync::Arc;
 use verti_sim::tools::BenchWorlds;
 use verti_sim::{VehicleSpec, vehicles};
@@ -19,24 +18,6 @@ pub enum VehicleCommand {
         #[arg(long)]
         yaml: bool,
     },
-}
-
-/// A built-in vehicle name or a path to a vehicle YAML file.
-/// A built-in vehicle by name, or a vehicle file. Anything that looks like a file (a YAML
-/// extension, a path separator) or exists is read as one, so a missing file is reported as such
-/// rather than as an unknown vehicle name (the same rule as Python's `vehicle=`).
-pub fn load_vehicle(name: &str) -> Result<VehicleSpec, Box<dyn std::error::Error>> {
-    if vehicles::builtin_names().contains(&name) {
-        return Ok(vehicles::builtin(name)?);
-    }
-    let path = Path::new(name);
-    let looks_like_file = path.extension().is_some_and(|e| e == "yaml" || e == "yml")
-        || name.contains(std::path::MAIN_SEPARATOR)
-        || path.exists();
-    if looks_like_file {
-        return Ok(VehicleSpec::from_file(path)?);
-    }
-    Ok(vehicles::builtin(name)?)
 }
 
 pub fn run_vehicle(cmd: VehicleCommand) -> CmdResult {

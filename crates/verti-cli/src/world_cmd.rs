@@ -1,5 +1,7 @@
 //! `verti world ...`
 
+use crate::cli_common::{CmdResult, ScaleArg, load_set_checked, note_shadowed};
+use crate::outputs::ensure_parent;
 use crate::progress::bar;
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
@@ -9,11 +11,8 @@ use verti_world::generate::sources::DEFAULT_SOURCE;
 use verti_world::generate::{SetConfig, generate_set_with, set_name};
 use verti_world::import_vb::{ImportOptions, import_vb, scan_vb_dir};
 use verti_world::paths::DEFAULT_CLEARANCE;
-use verti_world::scale::parse_scale;
-use verti_world::sets::{resolve_set, resolve_world};
+use verti_world::sets::resolve_world;
 use verti_world::{World, WorldError};
-
-pub type CmdResult = Result<(), Box<dyn std::error::Error>>;
 
 #[derive(Subcommand)]
 pub enum WorldCommand {
@@ -66,26 +65,6 @@ pub struct StatsArgs {
 }
 
 #[derive(Args)]
-pub struct ScaleArg {
-    /// World scale: 1, 1/6, 1/10 or any decimal in [1/1000, 10]. Every length is multiplied by it.
-    /// Default 1 for generated and imported worlds; saved worlds keep the scale they were saved
-    /// at, and asking for another is an error.
-    #[arg(long, value_parser = scale_parser)]
-    pub scale: Option<f64>,
-}
-
-impl ScaleArg {
-    /// The scale to generate or import at.
-    pub fn value(&self) -> f64 {
-        self.scale.unwrap_or(1.0)
-    }
-}
-
-fn scale_parser(s: &str) -> Result<f64, String> {
-    parse_scale(s).map_err(|e| e.to_string())
-}
-
-#[derive(Args)]
 pub struct GenerateArgs {
     /// Set seed; the same seed gives byte-identical files on every machine.
     #[arg(long, default_value_t = 0)]
@@ -102,7 +81,7 @@ pub struct GenerateArgs {
     #[arg(long, default_value = DEFAULT_SOURCE)]
     elevation: String,
     /// Elevation source parameter, name=value (repeatable).
-    #[arg(long = "elevation-param", value_parser = crate::eval_cmd::assignment)]
+    #[arg(long = "elevation-param", value_parser = crate::cli_common::assignment)]
     elevation_params: Vec<String>,
     /// Output directory (default: worlds/<set name>); its parent must exist.
     #[arg(long, value_parser = crate::outputs::out_dir)]
@@ -293,13 +272,6 @@ fn import(a: ImportArgs) -> CmdResult {
     Ok(())
 }
 
-/// Tells the user when a built-in set name is used although something of that name is here.
-fn note_shadowed(spec: &str) {
-    if let Some(note) = verti_world::sets::builtin_shadow_note(spec) {
-        eprintln!("note: {note}");
-    }
-}
-
 fn show(a: ShowArgs) -> CmdResult {
     note_shadowed(&a.world);
     let w = resolve_world_checked(&a.world, &a.scale)?;
@@ -339,13 +311,6 @@ fn stats(a: StatsArgs) -> CmdResult {
         }
     }
     Ok(())
-}
-
-/// Checks that an output file can be written: a picture format verti writes, in a directory
-/// that exists. Missing directories are not created (a typo should not grow a tree).
-pub fn ensure_parent(path: &Path) -> Result<(), WorldError> {
-    verti_core::output::check_output_file(path, verti_core::output::IMAGE_FORMATS)
-        .map_err(|problem| WorldError::Argument(format!("{}: {problem}", path.display())))
 }
 
 /// A short multi-line description of a world.
@@ -396,32 +361,9 @@ pub fn describe(w: &World) -> String {
     s
 }
 
-/// Resolves a set for commands that take one, with a progress bar.
-/// A world set at the requested scale, and its scale: an explicit `--scale` that a saved set
-/// cannot honour is an error rather than ignored.
-pub fn load_set_checked(
-    spec: &str,
-    scale: &ScaleArg,
-) -> Result<(verti_world::sets::WorldSet, f64), WorldError> {
-    let set = load_set_with_progress(spec, scale.value())?;
-    let actual = verti_world::scale::set_scale(spec, &set.worlds, scale.scale)?;
-    Ok((set, actual))
-}
-
 /// One world at the requested scale (see [`load_set_checked`]).
 fn resolve_world_checked(spec: &str, scale: &ScaleArg) -> Result<verti_world::World, WorldError> {
     let w = resolve_world(spec, scale.value())?;
     verti_world::scale::set_scale(spec, [&w], scale.scale)?;
     Ok(w)
-}
-
-pub fn load_set_with_progress(
-    spec: &str,
-    scale: f64,
-) -> Result<verti_world::sets::WorldSet, WorldError> {
-    note_shadowed(spec);
-    let pb = bar(0, "loading");
-    let set = resolve_set(spec, scale, &|| pb.inc(1));
-    pb.finish_and_clear();
-    set
 }

@@ -19,8 +19,8 @@
 //! any number of jobs.
 
 use crate::error::{CompareError, Result};
+use crate::outcome_counts::OutcomeCounts;
 use crate::run::{CompareSetup, pool, run_task};
-use crate::summary::OutcomeCounts;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;

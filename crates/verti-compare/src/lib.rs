@@ -12,6 +12,7 @@
 //!   from it change.
 //! * [`ensemble`]: each task re-run from starts a few centimetres apart, for the agreement one
 //!   run can be expected to reach on chaotic tasks.
+//! * [`outcome_counts`]: how many trials ended each way.
 //! * [`divergence`]: lateral offset from the reference's trajectory and roll error.
 //! * [`summary`]: per-task comparison and aggregates; [`markdown`]: the report's tables.
 //!
@@ -23,6 +24,7 @@ pub mod driver;
 pub mod ensemble;
 pub mod error;
 pub mod markdown;
+pub mod outcome_counts;
 pub mod reference;
 pub mod run;
 pub mod select;

@@ -1,8 +1,9 @@
 //! The comparison as Markdown: the headline table in the layout of the reference's README,
 //! then attitudes and divergence per group, the outcome confusion, and one row per task.
 
+use crate::outcome_counts::OutcomeCounts;
 use crate::run::Driver;
-use crate::summary::{Aggregate, OutcomeCounts, Summary, TaskComparison};
+use crate::summary::{Aggregate, Summary, TaskComparison};
 use std::fmt::Write;
 use verti_bench::{Outcome, Rules};
 

@@ -3,6 +3,8 @@
 //! successes, and trajectory divergence.
 
 use crate::divergence::{Window, divergence};
+// re-exported: `OutcomeCounts` was defined here, and `summary::OutcomeCounts` stays its path
+pub use crate::outcome_counts::OutcomeCounts;
 use crate::reference::RefTask;
 use crate::run::{CompareSetup, VertiRun};
 use serde::Serialize;
@@ -104,39 +106,6 @@ pub fn compare_task(reference: &RefTask, run: &VertiRun) -> TaskComparison {
         error: r.error.clone(),
         reference: ref_stats,
         verti,
-    }
-}
-
-/// How many trials ended each way.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-pub struct OutcomeCounts {
-    pub success: usize,
-    pub stuck: usize,
-    pub rollover: usize,
-    pub timeout: usize,
-    pub error: usize,
-}
-
-impl OutcomeCounts {
-    pub fn add(&mut self, o: Outcome) {
-        match o {
-            Outcome::Success => self.success += 1,
-            Outcome::Stuck => self.stuck += 1,
-            Outcome::Rollover => self.rollover += 1,
-            Outcome::Timeout => self.timeout += 1,
-            Outcome::Error => self.error += 1,
-        }
-    }
-
-    /// How many trials ended as `o`.
-    pub fn get(&self, o: Outcome) -> usize {
-        match o {
-            Outcome::Success => self.success,
-            Outcome::Stuck => self.stuck,
-            Outcome::Rollover => self.rollover,
-            Outcome::Timeout => self.timeout,
-            Outcome::Error => self.error,
-        }
     }
 }
 

@@ -13,6 +13,7 @@ pub mod curriculum;
 pub mod elev_maps;
 pub mod kino;
 pub mod kino_command;
+pub mod kino_shared;
 pub mod patches;
 pub mod pietra;
 pub mod ppo;

@@ -8,7 +8,9 @@
 //! standardised change with Adam on a cosine schedule; record validation loss now and then;
 //! export the three networks and one kinodynamic card.
 
-use crate::kino::{KinoConfig, KinoCurvePoint, KinoProvenance, KinoReport, export_network, rows};
+use crate::kino_shared::{
+    KinoConfig, KinoCurvePoint, KinoProvenance, KinoReport, export_network, rows,
+};
 use crate::seq::{Act, SeqNet, mlp_layers, values};
 use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams};

@@ -15,7 +15,7 @@
 //!   atom with positive mass.
 
 use crate::bins::{B, Pmf};
-use crate::model_lanes::{LANES, Lanes, sum_start};
+use crate::lanes::{LANES, Lanes, sum_start};
 
 /// Mass of one bin after the "negative or NaN counts as 0" rule.
 #[inline]

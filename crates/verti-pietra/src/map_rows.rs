@@ -15,12 +15,13 @@
 
 use crate::batch_mlp::BatchScratch;
 use crate::bins::{B, PARAMS, Pmf};
-use crate::cvar_map::{MapSpec, Region, Source, YAWS, pmf_cvars, yaw_of};
 use crate::dataset::{
     FEATURES, PATCH_CELL, PATCH_LENGTH, PATCH_WIDTH, SLOPE_BASE, height_at, height_on_grid,
 };
+use crate::lanes::{LANES, Lanes};
+use crate::map_spec::{MapSpec, Region, Source, YAWS, pmf_cvars, yaw_of};
 use crate::model::TravModel;
-use crate::model_lanes::{LANES, LaneInput, Lanes, finish_cvars};
+use crate::model_lanes::{LaneInput, finish_cvars};
 use crate::prior::{Footprint, physics_prior};
 use verti_world::Heightfield;
 

@@ -75,7 +75,7 @@ pub(crate) unsafe fn patches4(
     let gc0 = _mm256_set_pd(gc0[3], gc0[2], gc0[1], gc0[0]);
     let gr0 = _mm256_set1_pd(gr0);
     // the sum starts where `Iterator::sum` of f64 starts
-    let mut sum = _mm256_set1_pd(crate::model_lanes::sum_start());
+    let mut sum = _mm256_set1_pd(crate::lanes::sum_start());
     for p in 0..FEATURES {
         let gc = _mm256_add_pd(
             _mm256_add_pd(gc0, _mm256_set1_pd(cf[p])),

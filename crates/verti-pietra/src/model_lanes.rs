@@ -12,20 +12,8 @@
 
 use crate::bins::{B, Bins, PARAMS, Pmf, uniform};
 use crate::cvar::cvar_lanes;
+use crate::lanes::{LANES, Lanes, sum_start};
 use crate::model::TravModel;
-
-/// Footprints per call: one 256-bit vector of f64.
-pub(crate) const LANES: usize = 4;
-
-/// One value per lane.
-pub(crate) type Lanes = [f64; LANES];
-
-/// Where `Iterator::sum` of f64 starts (−0.0 in current Rust), so that sums written out by
-/// hand, lane by lane, equal it.
-#[inline(always)]
-pub(crate) fn sum_start() -> f64 {
-    std::iter::empty::<f64>().sum()
-}
 
 /// The inputs of [`finish_cvars`] for one lane: the latent, the decoders' logits, the
 /// evidence scaler's outputs and the physics prior of one footprint.

@@ -12,7 +12,7 @@
 //! [`dense_group_pair`] for why that keeps the bits). Where the CPU has AVX the same code is
 //! compiled for 256-bit registers.
 
-use crate::model::{FIELD_INPUT, POSE_DIM};
+use crate::dims::{FIELD_INPUT, POSE_DIM};
 
 /// Outputs per block (one 256-bit register of f32).
 const BLOCK: usize = 8;

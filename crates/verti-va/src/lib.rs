@@ -15,6 +15,7 @@ use std::path::PathBuf;
 
 pub mod adapter;
 pub mod data;
+mod dims;
 pub mod eval;
 pub mod explore;
 mod fields;

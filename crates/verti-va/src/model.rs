@@ -21,6 +21,9 @@
 //! [inputs][outputs], then biases), then the fields' layers stacked over the k fields
 //! (weights [k][inputs][outputs], then biases [k][outputs]).
 
+// the network's dimensions live in `dims` (the field kernel needs them too); `model::` stays
+// their public path
+pub use crate::dims::{EMBED, EMBED_HIDDEN, FIELD_INPUT, POSE_DIM};
 use crate::fields::{FieldKernel, StackedRef};
 use crate::lsq::{EXAMPLE_BATCH, NormalEquations};
 use crate::rk4::rk4_delta;
@@ -31,14 +34,6 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 pub const VA_FORMAT: u32 = 1;
-/// Heading-frame pose change: forward, left, up, yaw, roll, pitch (verti-kino's order).
-pub const POSE_DIM: usize = 6;
-/// Width of each compressed embedding (paper: 8).
-pub const EMBED: usize = 8;
-/// Inputs of a field: roll, pitch, two embeddings, speed, steering.
-pub const FIELD_INPUT: usize = 2 + 2 * EMBED + 2;
-/// Hidden widths of the embedding compressions (64 → 32 → 16 → 8, tanh at the end).
-pub const EMBED_HIDDEN: [usize; 2] = [32, 16];
 
 /// Which model family a card holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]

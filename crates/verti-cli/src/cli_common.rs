@@ -1,0 +1,90 @@
+//! What the commands share: their result type, the `--scale` and `name=value` arguments, and
+//! loading world sets and vehicles. It sits below every `*_cmd` module so that commands never
+//! import each other for these helpers (see `scripts/check_layers.py`).
+
+use crate::progress::bar;
+use clap::Args;
+use std::path::Path;
+use verti_sim::{VehicleSpec, vehicles};
+use verti_world::WorldError;
+use verti_world::scale::parse_scale;
+use verti_world::sets::resolve_set;
+
+pub type CmdResult = Result<(), Box<dyn std::error::Error>>;
+
+#[derive(Args)]
+pub struct ScaleArg {
+    /// World scale: 1, 1/6, 1/10 or any decimal in [1/1000, 10]. Every length is multiplied by it.
+    /// Default 1 for generated and imported worlds; saved worlds keep the scale they were saved
+    /// at, and asking for another is an error.
+    #[arg(long, value_parser = scale_parser)]
+    pub scale: Option<f64>,
+}
+
+impl ScaleArg {
+    /// The scale to generate or import at.
+    pub fn value(&self) -> f64 {
+        self.scale.unwrap_or(1.0)
+    }
+}
+
+fn scale_parser(s: &str) -> Result<f64, String> {
+    parse_scale(s).map_err(|e| e.to_string())
+}
+
+/// `name=value`; the value is read per the parameter's declared type once the system is known.
+pub fn assignment(s: &str) -> Result<String, String> {
+    if s.contains('=') {
+        Ok(s.to_string())
+    } else {
+        Err(format!("parameter `{s}` must look like name=value"))
+    }
+}
+
+/// A built-in vehicle name or a path to a vehicle YAML file.
+/// A built-in vehicle by name, or a vehicle file. Anything that looks like a file (a YAML
+/// extension, a path separator) or exists is read as one, so a missing file is reported as such
+/// rather than as an unknown vehicle name (the same rule as Python's `vehicle=`).
+pub fn load_vehicle(name: &str) -> Result<VehicleSpec, Box<dyn std::error::Error>> {
+    if vehicles::builtin_names().contains(&name) {
+        return Ok(vehicles::builtin(name)?);
+    }
+    let path = Path::new(name);
+    let looks_like_file = path.extension().is_some_and(|e| e == "yaml" || e == "yml")
+        || name.contains(std::path::MAIN_SEPARATOR)
+        || path.exists();
+    if looks_like_file {
+        return Ok(VehicleSpec::from_file(path)?);
+    }
+    Ok(vehicles::builtin(name)?)
+}
+
+/// Tells the user when a built-in set name is used although something of that name is here.
+pub fn note_shadowed(spec: &str) {
+    if let Some(note) = verti_world::sets::builtin_shadow_note(spec) {
+        eprintln!("note: {note}");
+    }
+}
+
+/// Resolves a set for commands that take one, with a progress bar.
+/// A world set at the requested scale, and its scale: an explicit `--scale` that a saved set
+/// cannot honour is an error rather than ignored.
+pub fn load_set_checked(
+    spec: &str,
+    scale: &ScaleArg,
+) -> Result<(verti_world::sets::WorldSet, f64), WorldError> {
+    let set = load_set_with_progress(spec, scale.value())?;
+    let actual = verti_world::scale::set_scale(spec, &set.worlds, scale.scale)?;
+    Ok((set, actual))
+}
+
+pub fn load_set_with_progress(
+    spec: &str,
+    scale: f64,
+) -> Result<verti_world::sets::WorldSet, WorldError> {
+    note_shadowed(spec);
+    let pb = bar(0, "loading");
+    let set = resolve_set(spec, scale, &|| pb.inc(1));
+    pb.finish_and_clear();
+    set
+}
