@@ -4,8 +4,7 @@
 
 use crate::progress::bar;
 use clap::Args;
-use std::path::Path;
-use verti_sim::{VehicleSpec, vehicles};
+use verti_sim::VehicleSpec;
 use verti_world::WorldError;
 use verti_world::scale::parse_scale;
 use verti_world::sets::resolve_set;
@@ -41,22 +40,10 @@ pub fn assignment(s: &str) -> Result<String, String> {
     }
 }
 
-/// A built-in vehicle name or a path to a vehicle YAML file.
-/// A built-in vehicle by name, or a vehicle file. Anything that looks like a file (a YAML
-/// extension, a path separator) or exists is read as one, so a missing file is reported as such
-/// rather than as an unknown vehicle name (the same rule as Python's `vehicle=`).
+/// A built-in vehicle by name, or a vehicle YAML file: `verti_registry::vehicle`, the rule the
+/// Python bindings use too.
 pub fn load_vehicle(name: &str) -> Result<VehicleSpec, Box<dyn std::error::Error>> {
-    if vehicles::builtin_names().contains(&name) {
-        return Ok(vehicles::builtin(name)?);
-    }
-    let path = Path::new(name);
-    let looks_like_file = path.extension().is_some_and(|e| e == "yaml" || e == "yml")
-        || name.contains(std::path::MAIN_SEPARATOR)
-        || path.exists();
-    if looks_like_file {
-        return Ok(VehicleSpec::from_file(path)?);
-    }
-    Ok(vehicles::builtin(name)?)
+    Ok(verti_registry::vehicle(name)?)
 }
 
 /// Tells the user when a built-in set name is used although something of that name is here.

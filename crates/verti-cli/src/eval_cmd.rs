@@ -10,6 +10,7 @@ use verti_bench::episode::{EpisodeLog, Outcome, Rules, StartMode};
 use verti_bench::eval::{EvalSetup, RunInfo, evaluate, parse_tasks};
 use verti_bench::identity::SplitRecord;
 use verti_bench::{EpisodeConfig, run_episode};
+use verti_registry::ReadySystem;
 use verti_world::World;
 
 pub fn systems_list() -> CmdResult {
@@ -111,7 +112,8 @@ pub fn eval(a: EvalArgs) -> CmdResult {
     let registry = crate::registries::systems();
     let systems = system_names(&a.system, &registry)?;
     let several = systems.len() > 1;
-    // every system's parameters, resolved and built once before any work: a typo fails now
+    // every system's parameters, checked against its declarations before any work: a typo
+    // fails now
     let mut resolved = Vec::new();
     for system in &systems {
         let info = registry.info(system)?;
@@ -127,9 +129,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
             })
             .map(|p| registry.parse_param(system, p))
             .collect::<Result<Vec<_>, _>>()?;
-        let params = registry.resolve(system, &given)?;
-        registry.build(system, &params)?;
-        resolved.push(params);
+        resolved.push(registry.resolve(system, &given)?);
     }
     if several {
         for p in &a.params {
@@ -148,6 +148,14 @@ pub fn eval(a: EvalArgs) -> CmdResult {
             }
         }
     }
+    // what only building checks (a model card that must load, a plan that must fit in memory,
+    // the oracle's whole control periods), still before any work: each system's instance built
+    // for it drives that system's first trial
+    let ready = systems
+        .iter()
+        .zip(resolved)
+        .map(|(system, params)| ReadySystem::new(&registry, system, params))
+        .collect::<Result<Vec<_>, _>>()?;
     let perception = verti_bench::perception::PerceptionModel::load(&a.perception)
         .map_err(|e| format!("--perception: {e}"))?;
     let (set, scale) = load_set_checked(&a.worlds, &a.scale)?;
@@ -165,17 +173,16 @@ pub fn eval(a: EvalArgs) -> CmdResult {
     let per_system = verti_bench::eval::select_tasks(&worlds, &selection)?.len();
     // one progress display for the whole sequence
     let pb = bar((per_system * systems.len()) as u64, &systems.join(", "));
-    for (system, params) in systems.iter().zip(resolved) {
+    for system in &ready {
         let out = match (&a.out, several) {
             (Some(dir), false) => dir.clone(),
-            (Some(dir), true) => dir.join(system),
-            (None, _) => PathBuf::from("results").join(format!("{system}-{set_name}")),
+            (Some(dir), true) => dir.join(system.name()),
+            (None, _) => PathBuf::from("results").join(format!("{}-{set_name}", system.name())),
         };
-        pb.set_message(system.clone());
+        pb.set_message(system.name().to_string());
         let shared = Shared {
             selection: &selection,
             perception: (!perception.is_none()).then(|| Arc::new(perception.clone())),
-            registry: &registry,
             worlds: &worlds,
             vehicle: &vehicle,
             scale,
@@ -183,7 +190,7 @@ pub fn eval(a: EvalArgs) -> CmdResult {
             pb: &pb,
             shard: split.clone(),
         };
-        let lines = eval_system(&a, system, params, &shared, &out)?;
+        let lines = eval_system(&a, system, &shared, &out)?;
         for line in lines {
             // above the bar where there is one; plain stdout otherwise (logs, pipes)
             if pb.is_hidden() {
@@ -238,7 +245,6 @@ fn shard_selection(
 struct Shared<'a> {
     selection: &'a [u32],
     perception: Option<Arc<verti_bench::perception::PerceptionModel>>,
-    registry: &'a verti_bench::SystemRegistry,
     worlds: &'a [Arc<World>],
     vehicle: &'a verti_sim::VehicleSpec,
     scale: f64,
@@ -251,13 +257,12 @@ struct Shared<'a> {
 /// One system's evaluation; returns its summary lines.
 fn eval_system(
     a: &EvalArgs,
-    system: &str,
-    params: verti_core::params::Params,
+    ready: &ReadySystem,
     sh: &Shared,
     out: &std::path::Path,
 ) -> Result<Vec<String>, verti_bench::eval::EvalError> {
-    let (registry, worlds, vehicle, scale, pb) =
-        (sh.registry, sh.worlds, sh.vehicle, sh.scale, sh.pb);
+    let (worlds, vehicle, scale, pb) = (sh.worlds, sh.vehicle, sh.scale, sh.pb);
+    let (system, params) = (ready.name(), ready.params());
     let selection = sh.selection;
     let jobs = a.jobs.unwrap_or_else(rayon::current_num_threads);
     let episode = EpisodeConfig {
@@ -275,7 +280,7 @@ fn eval_system(
         verti_log::write_steps(&path, r, &log.steps).map_err(|e| e.to_string())
     };
     let inputs = |tasks: &[(usize, u32)]| {
-        verti_bench::identity::system_inputs(registry, system, &params, worlds, tasks)
+        verti_bench::identity::system_inputs(ready.registry(), system, params, worlds, tasks)
     };
     let setup = EvalSetup {
         worlds,
@@ -308,11 +313,7 @@ fn eval_system(
         cancel: None,
         warn: Some(&warn),
     };
-    let make = || {
-        registry
-            .build(system, &params)
-            .expect("the system was built once already")
-    };
+    let make = || ready.make();
     let t0 = std::time::Instant::now();
     let results = evaluate(&setup, selection, &make, &|_| pb.inc(1))?;
     let wall = t0.elapsed().as_secs_f64();

@@ -21,6 +21,7 @@ mod outputs;
 mod pietra_cmd;
 mod progress;
 mod registries;
+mod sim_tools;
 mod vehicle_cmd;
 mod world_cmd;
 

@@ -1,37 +1,8 @@
-//! The registries of the command line: every crate that provides mobility systems or
-//! elevation sources registers them here (a crate above verti-systems adds its `register`
-//! call next to the built-in ones).
+//! The registries of the command line: assembled once, in `verti-registry`, for the command
+//! line and the Python module alike (a crate that provides systems or elevation sources
+//! registers them there).
 
-use verti_bench::SystemRegistry;
-use verti_world::generate::sources::ElevationRegistry;
-
-/// Every mobility system `verti` can run.
-pub fn systems() -> SystemRegistry {
-    let mut r = SystemRegistry::new();
-    verti_systems::register(&mut r);
-    // the learned planners (MPPI over shipped kinodynamic models), evaluated without burn
-    verti_kino::systems::register(&mut r, verti_kino::shipped::systems())
-        .expect("learned system names are unique");
-    // the driving policies trained with PPO (rl, mcl, acl), evaluated without burn
-    verti_policy::system::register(&mut r, verti_policy::shipped::systems())
-        .expect("policy system names are unique");
-    // PIETRA's risk-aware planner over the shipped traversability model, evaluated without burn
-    verti_pietra::system::register(&mut r, verti_pietra::shipped::pietra_v1)
-        .expect("system names are unique");
-    // VertiAdaptor: MPPI over the shipped function encoder with online least squares
-    verti_va::system::register(&mut r, verti_va::shipped::va_small_v1)
-        .expect("system names are unique");
-    r
-}
-
-/// Every elevation source `verti world generate` can use.
-pub fn elevation_sources() -> ElevationRegistry {
-    let mut r = ElevationRegistry::new();
-    verti_world::generate::sources::register(&mut r);
-    // the trained SWAE (`swae-v1`), evaluated without burn
-    verti_nn::shipped::register_sources(&mut r);
-    r
-}
+pub use verti_registry::{elevation_sources, systems};
 
 /// Prints each entry of a registry with its parameters: name, type, default, accepted values
 /// and doc.

@@ -2,9 +2,9 @@
 
 use crate::cli_common::{CmdResult, load_set_with_progress, load_vehicle};
 use crate::progress::bar;
+use crate::sim_tools::{self, BenchWorlds};
 use clap::{Args, Subcommand};
 use std::sync::Arc;
-use verti_sim::tools::BenchWorlds;
 use verti_sim::{VehicleSpec, vehicles};
 
 #[derive(Subcommand)]
@@ -124,7 +124,7 @@ pub fn run_sim(cmd: SimCommand) -> CmdResult {
             }
             let specs = vehicles_arg(&a.vehicle)?;
             let worlds = BenchWorlds::generated_for(&specs)?;
-            let report = verti_sim::tools::bench(&worlds, &specs, a.seconds, a.runs);
+            let report = sim_tools::bench(&worlds, &specs, a.seconds, a.runs);
             if a.json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else {
@@ -148,7 +148,7 @@ pub fn run_sim(cmd: SimCommand) -> CmdResult {
                 }
             }
             let pb = bar(a.steps, "soak");
-            let report = verti_sim::tools::soak(&worlds, &specs, a.steps, a.seed, |done| {
+            let report = sim_tools::soak(&worlds, &specs, a.steps, a.seed, |done| {
                 pb.set_position(done)
             });
             pb.finish_and_clear();

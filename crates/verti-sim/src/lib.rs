@@ -14,8 +14,8 @@
 //! * [`SimState`]: the mutable, cheap-to-clone state, with per-wheel [`WheelState`],
 //!   a [`ContactInfo`] summary and the [`SoilState`] deformation; [`Pose`] of the chassis.
 //! * [`SimError`] and [`SpecError`]: every failure is an error, never a panic.
-//! * [`testing`]: small programmatic worlds for tests; [`tools`]: the speed benchmark and the
-//!   soak behind `verti sim bench` / `verti sim soak`.
+//! * [`testing`]: small programmatic worlds for tests. The speed benchmark and the soak
+//!   (`verti sim bench` / `verti sim soak`) live in the CLI, apart from the engine.
 //!
 //! ```no_run
 //! use std::sync::Arc;
@@ -53,7 +53,6 @@ mod step_rigid;
 mod suspension;
 mod terrain;
 pub mod testing;
-pub mod tools;
 mod tyre;
 pub mod vehicles;
 

@@ -1,6 +1,7 @@
 //! Evaluation: built-in systems run in parallel in Rust, results as dicts.
 
 use super::*;
+use verti_registry::ReadySystem;
 
 /// Wraps a system so an interrupted evaluation ends its running trials at their next control
 /// step: once `cancel` is raised the system returns an invalid action, which `run_episode`
@@ -93,25 +94,6 @@ pub(super) fn results_to_py(py: Python<'_>, results: &[TrialResult]) -> PyResult
             Ok(loads.call1((text,))?.unbind())
         })
         .collect()
-}
-
-/// The systems Python can run: the built-in ones and those of crates above verti-systems.
-pub(super) fn system_registry() -> verti_bench::SystemRegistry {
-    let mut r = verti_bench::SystemRegistry::new();
-    verti_systems::register(&mut r);
-    // the hybrids whose trained models ship (mppi6, wmvct, tal, tnt): no burn involved
-    verti_kino::systems::register(&mut r, verti_kino::shipped::systems())
-        .expect("the shipped learned systems have distinct names and valid parameters");
-    // the PPO driving policies (rl, mcl, acl)
-    verti_policy::system::register(&mut r, verti_policy::shipped::systems())
-        .expect("the shipped policies have distinct names and valid parameters");
-    // PIETRA's risk-aware planner over the shipped traversability model
-    verti_pietra::system::register(&mut r, verti_pietra::shipped::pietra_v1)
-        .expect("pietra has a distinct name and valid parameters");
-    // VertiAdaptor over the shipped function encoder
-    verti_va::system::register(&mut r, verti_va::shipped::va_small_v1)
-        .expect("va has a distinct name and valid parameters");
-    r
 }
 
 /// One parameter value: bool, int, float, str or a path (`pathlib.Path`), as the same
@@ -248,13 +230,15 @@ pub(super) fn evaluate(
     let system: String = system.extract()?;
     let system = system.as_str();
     let registry = system_registry();
+    // unknown names and bad parameters fail here, against the declarations, before any work
     let params = registry
         .resolve(system, &params_arg(params)?)
         .map_err(|e| value_err(e.to_string()))?;
-    // build one system up front so unknown names and bad parameters fail before any work
-    registry
-        .build(system, &params)
-        .map_err(|e| value_err(e.to_string()))?;
+    // what only building checks (a model card that must load, a plan that must fit in
+    // memory): the instance built for it drives the first trial
+    let ready =
+        ReadySystem::new(&registry, system, params).map_err(|e| value_err(e.to_string()))?;
+    let params = ready.params();
     let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     verti_bench::eval::check_jobs(jobs, "jobs").map_err(value_err)?;
     let Prepared {
@@ -280,7 +264,7 @@ pub(super) fn evaluate(
                         if cancel.load(Ordering::Relaxed) {
                             return None;
                         }
-                        let inner = registry.build(system, &params).expect("checked above");
+                        let inner = ready.make();
                         let mut sys = Cancellable {
                             inner,
                             cancel: cancel.clone(),
@@ -328,7 +312,7 @@ pub(super) fn evaluate(
     // `evaluate` reads an empty selection as "all tasks"; nothing selected runs nothing
     let mut all = Vec::new();
     let inputs = |tasks: &[(usize, u32)]| {
-        verti_bench::identity::system_inputs(&registry, system, &params, &worlds, tasks)
+        verti_bench::identity::system_inputs(&registry, system, params, &worlds, tasks)
     };
     if !numbers.is_empty() {
         let setup = EvalSetup {
@@ -349,7 +333,7 @@ pub(super) fn evaluate(
         // trials in flight stop at their next control step on Ctrl-C, and are not recorded
         let make = || -> Box<dyn MobilitySystem> {
             Box::new(Cancellable {
-                inner: registry.build(system, &params).expect("checked above"),
+                inner: ready.make(),
                 cancel: cancel.clone(),
             })
         };

@@ -31,9 +31,9 @@ use verti_env::{
     ActionMode, EnvConfig, EnvCore, EnvError, Episode, ObsBuf, RewardConfig, StepReport,
     TaskFilter, VecCore, encode_observation, outcome_code,
 };
+use verti_registry::systems as system_registry;
 use verti_sim::{Controls, SimError, SpecError, VehicleSpec};
 use verti_world::generate::elevation::ElevationSource;
-use verti_world::generate::sources::ElevationRegistry;
 use verti_world::generate::{SetConfig, composition, generate_world};
 use verti_world::{ElevationLevel, ObstacleDensity, TaskId, TerrainType, World, WorldError};
 

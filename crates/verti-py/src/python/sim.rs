@@ -4,14 +4,7 @@ use super::*;
 
 /// A vehicle by built-in name (`hmmwv`, `artcar`, ...) or path to a vehicle YAML file.
 pub(super) fn vehicle_spec(name: &str) -> PyResult<VehicleSpec> {
-    if verti_sim::vehicles::builtin_names().contains(&name) {
-        return verti_sim::vehicles::builtin(name).map_err(spec_err);
-    }
-    let path = std::path::Path::new(name);
-    if path.extension().is_some_and(|e| e == "yaml" || e == "yml") || path.exists() {
-        return VehicleSpec::from_file(path).map_err(spec_err);
-    }
-    verti_sim::vehicles::builtin(name).map_err(spec_err)
+    verti_registry::vehicle(name).map_err(spec_err)
 }
 
 /// Names of the built-in vehicles.

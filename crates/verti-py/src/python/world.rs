@@ -15,9 +15,7 @@ pub(super) fn elevation_source(
     name: &str,
     params: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Box<dyn ElevationSource>> {
-    let mut registry = ElevationRegistry::new();
-    verti_world::generate::sources::register(&mut registry);
-    verti_nn::shipped::register_sources(&mut registry);
+    let registry = verti_registry::elevation_sources();
     let mut given = Vec::new();
     if let Some(d) = params {
         for (k, v) in d.iter() {

@@ -1,15 +1,12 @@
 //! The random-input robustness run behind `verti sim soak`: random starts, random held inputs,
 //! every error recorded with the seed that reproduces it.
 
-use crate::error::SimError;
-use crate::sim::Sim;
-use crate::spec::VehicleSpec;
-use crate::state::{Controls, SimState, StartPose};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::sync::Arc;
 use std::time::Instant;
 use verti_core::Rng;
+use verti_sim::{Controls, Sim, SimError, SimState, StartPose, VehicleSpec};
 use verti_world::World;
 
 /// One episode that ended with a non-finite or absurd state.

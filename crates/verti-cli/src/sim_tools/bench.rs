@@ -1,14 +1,11 @@
 //! The speed benchmark behind `verti sim bench`: a scripted driver on a rigid and a soil world
 //! per vehicle scale, timed single-threaded.
 
-use crate::sim::Sim;
-use crate::spec::VehicleSpec;
-use crate::state::{Controls, SimState, StartPose};
-use crate::testing::{RoughSurface, rough_world};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::sync::Arc;
 use std::time::Instant;
+use verti_sim::{Controls, Sim, SimState, StartPose, VehicleSpec};
 use verti_world::World;
 
 /// A rigid and a deformable world for one world scale.
@@ -28,28 +25,6 @@ pub struct BenchWorlds {
 }
 
 impl BenchWorlds {
-    /// Synthetic rough worlds (see [`crate::testing::rough_world`]) for each scale.
-    pub fn synthetic(scales: &[f64]) -> BenchWorlds {
-        let mut pairs: Vec<BenchWorldPair> = Vec::new();
-        for &s in scales {
-            if pairs.iter().any(|p| (p.scale - s).abs() < 1e-9) {
-                continue;
-            }
-            pairs.push(BenchWorldPair {
-                scale: s,
-                rigid: Arc::new(rough_world(s, 1, 16.0, RoughSurface::Rigid)),
-                soil: Arc::new(rough_world(s, 2, 4.8, RoughSurface::Soil)),
-            });
-        }
-        BenchWorlds { pairs }
-    }
-
-    /// Synthetic worlds for the scales of the given vehicles.
-    pub fn synthetic_for(vehicles: &[VehicleSpec]) -> BenchWorlds {
-        let scales: Vec<f64> = vehicles.iter().map(|v| v.scale).collect();
-        BenchWorlds::synthetic(&scales)
-    }
-
     /// Worlds of the built-in generated set `verti-100` (seed 0): for each scale, the first
     /// world that is high-elevation, rigid and dense, and the first deformable world of the
     /// highest elevation level available. Errors when the generator fails.
