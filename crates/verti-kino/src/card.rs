@@ -2,14 +2,14 @@
 //! training record, plus one verti-nn network file per network it is made of (ensemble
 //! members, heads).
 
+use crate::Result;
 use crate::attentive::{ATTENTIVE_INPUT_DIM, HEAD_DIM, MAP_DIM, OFFSET_DIM};
 use crate::features::{INPUT_DIM, OUTPUT_DIM};
-use crate::{KinoError, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
-use verti_nn::{Mlp, Network};
+use verti_nn::{Mlp, ModelError, Network};
 
 /// Current card format.
 pub const KINO_FORMAT: u32 = 1;
@@ -97,11 +97,7 @@ pub struct KinoFile {
 impl KinoFile {
     /// Checks a card and its networks: dimensions, step, formats.
     pub fn new(card: KinoCard, networks: Vec<Arc<Network>>, origin: &Path) -> Result<KinoFile> {
-        let bad = |field: &str, why: String| KinoError::Card {
-            path: origin.to_path_buf(),
-            field: field.to_string(),
-            why,
-        };
+        let bad = |field: &str, why: String| ModelError::card(origin, field, why);
         if card.format != KINO_FORMAT {
             return Err(bad(
                 "format",
@@ -168,10 +164,7 @@ impl KinoFile {
 
     /// Reads a card and the networks it lists (beside it).
     pub fn load(path: &Path) -> Result<KinoFile> {
-        let text = std::fs::read_to_string(path).map_err(|e| KinoError::Io {
-            path: path.to_path_buf(),
-            source: e,
-        })?;
+        let text = std::fs::read_to_string(path).map_err(|e| ModelError::io(path, e))?;
         let card = parse_card(&text, path)?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let networks = card
@@ -180,11 +173,7 @@ impl KinoFile {
             .map(|f| {
                 Network::load(&dir.join(f))
                     .map(Arc::new)
-                    .map_err(|e| KinoError::Card {
-                        path: path.to_path_buf(),
-                        field: "networks".into(),
-                        why: e.to_string(),
-                    })
+                    .map_err(|e| ModelError::card(path, "networks", e))
             })
             .collect::<Result<Vec<_>>>()?;
         KinoFile::new(card, networks, path)
@@ -193,21 +182,14 @@ impl KinoFile {
     /// Writes the card to `path` and each network beside it under its listed name.
     pub fn save(&self, path: &Path) -> Result<()> {
         let dir = path.parent().unwrap_or(Path::new("."));
-        let io = |p: PathBuf, e: std::io::Error| KinoError::Io { path: p, source: e };
-        std::fs::create_dir_all(dir).map_err(|e| io(dir.to_path_buf(), e))?;
+        std::fs::create_dir_all(dir).map_err(|e| ModelError::io(dir, e))?;
         for (file, net) in self.card.networks.iter().zip(&self.networks) {
-            net.save(&dir.join(file)).map_err(|e| KinoError::Card {
-                path: dir.join(file),
-                field: "networks".into(),
-                why: e.to_string(),
-            })?;
+            net.save(&dir.join(file))
+                .map_err(|e| ModelError::card(&dir.join(file), "networks", e))?;
         }
-        let text = serde_norway::to_string(&self.card).map_err(|e| KinoError::Card {
-            path: path.to_path_buf(),
-            field: "card".into(),
-            why: e.to_string(),
-        })?;
-        std::fs::write(path, text).map_err(|e| io(path.to_path_buf(), e))
+        let text =
+            serde_norway::to_string(&self.card).map_err(|e| ModelError::card(path, "card", e))?;
+        std::fs::write(path, text).map_err(|e| ModelError::io(path, e))
     }
 }
 
@@ -276,20 +258,18 @@ fn fold_attentive(
 pub fn parse_card(text: &str, path: &Path) -> Result<KinoCard> {
     // a common slip: one of the model's network cards instead of the model card
     if text.lines().any(|l| l.starts_with("layers:")) && !text.contains("\nnetworks:") {
-        return Err(KinoError::Card {
-            path: path.to_path_buf(),
-            field: "card".into(),
-            why: "this is a network card (one of a model's networks); pass the model's own card \
-                  (e.g. models/mppi6-v1.yaml), which lists its networks"
-                .into(),
-        });
+        return Err(ModelError::card(
+            path,
+            "card",
+            "this is a network card (one of a model's networks); pass the model's own card \
+             (e.g. models/mppi6-v1.yaml), which lists its networks",
+        ));
     }
-    serde_norway::from_str(text).map_err(|e| KinoError::Card {
-        path: path.to_path_buf(),
-        field: e
+    serde_norway::from_str(text).map_err(|e| {
+        let field = e
             .location()
             .map(|l| format!("line {}", l.line()))
-            .unwrap_or_else(|| "card".into()),
-        why: e.to_string(),
+            .unwrap_or_else(|| "card".into());
+        ModelError::card(path, &field, e)
     })
 }

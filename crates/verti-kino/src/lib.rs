@@ -11,8 +11,6 @@
 //! * [`systems`]: the registered planners (`mppi6`, `wmvct`, `tal`, `tnt`);
 //! * [`shipped`]: the trained models compiled in.
 
-use std::path::PathBuf;
-
 pub mod attentive;
 pub mod card;
 pub mod eval;
@@ -28,21 +26,7 @@ pub use card::{KinoCard, KinoFile, KinoKind};
 pub use features::{KinoState, Units};
 pub use model::{Geometry, KinoModel};
 
-#[derive(Debug, thiserror::Error)]
-pub enum KinoError {
-    #[error("{path}: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("{path}: {field}: {why}")]
-    Card {
-        path: PathBuf,
-        field: String,
-        why: String,
-    },
-    #[error("{0}")]
-    Data(String),
-}
+/// Errors of model files and training data: verti-nn's, the one error of every model.
+pub use verti_nn::ModelError as KinoError;
 
 pub type Result<T> = std::result::Result<T, KinoError>;

@@ -4,95 +4,52 @@
 use crate::card::{KinoFile, parse_card};
 use crate::systems::LearnedSystem;
 use crate::traversability::Traversability;
-use std::path::Path;
 use std::sync::Arc;
-use verti_nn::Network;
-
-/// One shipped network: its card and weights.
-struct EmbeddedNet {
-    card: &'static str,
-    weights: &'static [u8],
-    path: &'static str,
-}
-
-/// One shipped model: its card and networks.
-struct Embedded {
-    card: &'static str,
-    path: &'static str,
-    networks: &'static [EmbeddedNet],
-}
-
-macro_rules! net {
-    ($stem:literal) => {
-        EmbeddedNet {
-            card: include_str!(concat!("../../../models/", $stem, ".yaml")),
-            weights: include_bytes!(concat!("../../../models/", $stem, ".bin")),
-            path: concat!("models/", $stem, ".yaml"),
-        }
-    };
-}
+use verti_nn::{Embedded, ModelError, embed};
 
 const SHIPPED: &[Embedded] = &[
-    Embedded {
-        card: include_str!("../../../models/mppi6-v1.yaml"),
-        path: "models/mppi6-v1.yaml",
-        networks: &[net!("mppi6-v1.net0"), net!("mppi6-v1.net1")],
-    },
-    Embedded {
-        card: include_str!("../../../models/wmvct-v1.yaml"),
-        path: "models/wmvct-v1.yaml",
-        networks: &[net!("wmvct-v1.net0")],
-    },
-    Embedded {
-        card: include_str!("../../../models/tal-v1.yaml"),
-        path: "models/tal-v1.yaml",
-        networks: &[
-            net!("tal-v1.encoder"),
-            net!("tal-v1.gate"),
-            net!("tal-v1.dynamics"),
-        ],
-    },
+    embed!("mppi6-v1", ["mppi6-v1.net0", "mppi6-v1.net1"]),
+    embed!("wmvct-v1", ["wmvct-v1.net0"]),
+    embed!(
+        "tal-v1",
+        ["tal-v1.encoder", "tal-v1.gate", "tal-v1.dynamics"]
+    ),
 ];
 
-fn load(e: &Embedded) -> Result<Arc<KinoFile>, String> {
-    let path = Path::new(e.path);
-    let card = parse_card(e.card, path).map_err(|x| x.to_string())?;
-    let networks = e
+/// TNT's traversability network.
+const TNT_V1: Embedded = embed!("tnt-v1");
+
+/// A model card and the networks it lists, from what is compiled in.
+fn load(e: &Embedded) -> Result<Arc<KinoFile>, ModelError> {
+    let card = parse_card(e.card, e.origin())?;
+    let networks = card
         .networks
         .iter()
-        .map(|n| {
-            let p = Path::new(n.path);
-            let c = verti_nn::network::parse_card(n.card, p).map_err(|x| x.to_string())?;
-            Network::from_bytes(c, n.weights, p)
-                .map(Arc::new)
-                .map_err(|x| x.to_string())
-        })
-        .collect::<Result<Vec<_>, String>>()?;
-    KinoFile::new(card, networks, path)
-        .map(Arc::new)
-        .map_err(|x| x.to_string())
+        .map(|file| e.part(file)?.network().map(Arc::new))
+        .collect::<Result<Vec<_>, _>>()?;
+    KinoFile::new(card, networks, e.origin()).map(Arc::new)
 }
 
 /// A shipped model by name (`mppi6-v1`, ...).
 pub fn model(name: &str) -> Result<Arc<KinoFile>, String> {
     let e = SHIPPED
         .iter()
-        .find(|e| e.path == format!("models/{name}.yaml"))
+        .find(|e| e.name() == name)
         .ok_or_else(|| format!("no shipped kinodynamic model `{name}`"))?;
-    load(e)
+    load(e).map_err(|e| e.to_string())
 }
 
 /// Every shipped model.
 pub fn all() -> Result<Vec<Arc<KinoFile>>, String> {
-    SHIPPED.iter().map(load).collect()
+    SHIPPED
+        .iter()
+        .map(|e| load(e).map_err(|e| e.to_string()))
+        .collect()
 }
 
 /// The shipped traversability network of TNT (`verti learn kino --model tnt --steps 2000`).
 pub fn traversability() -> Result<Traversability, String> {
-    let n = net!("tnt-v1");
-    let p = Path::new(n.path);
-    let card = verti_nn::network::parse_card(n.card, p).map_err(|x| x.to_string())?;
-    let net = Network::from_bytes(card, n.weights, p).map_err(|x| x.to_string())?;
+    let net = TNT_V1.network().map_err(|e| e.to_string())?;
     Traversability::new(Arc::new(net))
 }
 

@@ -3,9 +3,12 @@
 //! command, how long it took and how well it did. The weights file is raw little-endian f32,
 //! layer by layer (weights, then biases), checked against the card's count and digest.
 
+use crate::error::ModelError;
 use crate::layer::{LayerSpec, Shape};
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::path::Path;
 
 /// Format version written by this crate.
 pub const CARD_FORMAT: u32 = 1;
@@ -85,6 +88,58 @@ impl ModelCard {
             constants: BTreeMap::new(),
         }
     }
+}
+
+impl WeightsInfo {
+    /// Checks that `bytes` are the weights this record describes: [`WeightsInfo::floats`]
+    /// little-endian f32 values whose digest is [`WeightsInfo::fnv1a64`]. `origin` names the
+    /// card in errors, which also name the field whose record the bytes do not match. Every
+    /// model's weights pass this check, whichever card they come with and whether they come
+    /// from a file or are compiled in.
+    pub fn check(&self, bytes: &[u8], origin: &Path) -> Result<(), ModelError> {
+        if self.floats.checked_mul(4) != Some(bytes.len()) {
+            return Err(ModelError::invalid(
+                origin,
+                format!(
+                    "field weights.floats: weights file {} has {} bytes, expected {} ({} f32 values): truncated or not this model's",
+                    self.file,
+                    bytes.len(),
+                    // in u128: a count from the card may be near usize::MAX
+                    4 * self.floats as u128,
+                    self.floats,
+                ),
+            ));
+        }
+        let digest = format!("{:016x}", fnv1a64(bytes));
+        if digest != self.fnv1a64 {
+            return Err(ModelError::invalid(
+                origin,
+                format!(
+                    "field weights.fnv1a64: weights file {} has digest {digest}, the card says {}: the file does not belong to this card",
+                    self.file, self.fnv1a64
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A card that names one weights file: verti-nn's [`ModelCard`], and the cards of models that
+/// are not plain networks (VertiAdaptor's) but keep their weights the same way.
+pub trait WeightsCard: DeserializeOwned {
+    fn weights_info(&self) -> &WeightsInfo;
+}
+
+impl WeightsCard for ModelCard {
+    fn weights_info(&self) -> &WeightsInfo {
+        &self.weights
+    }
+}
+
+/// Parses a card's YAML (any card type), naming the file and the problem.
+pub fn parse<C: DeserializeOwned>(text: &str, path: &Path) -> Result<C, ModelError> {
+    serde_norway::from_str(text)
+        .map_err(|e| ModelError::invalid(path, format!("not a model card: {e}")))
 }
 
 /// FNV-1a, 64 bit: a dependency-free digest to catch truncated or swapped weight files.

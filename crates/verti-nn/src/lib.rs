@@ -10,10 +10,15 @@
 //! * [`Mlp`]: the allocation-free MLP path for networks called inside planners;
 //! * [`swae`]: the `swae-v1` elevation source (terrain from the trained SWAE decoder);
 //! * [`patch`]: the local-patch terrain encoder used by learned systems;
-//! * [`shipped`]: the trained models that ship in the repository (`models/`).
+//! * [`embed`]: how every crate compiles in the trained models that ship in the repository
+//!   (`models/`), checked against their cards ([`embed!`]), with the one error of model files,
+//!   [`ModelError`];
+//! * [`shipped`]: verti-nn's own shipped models (`swae-v1`, `patch-v1`).
 
 pub mod card;
 pub mod dense;
+pub mod embed;
+pub mod error;
 pub mod files;
 pub mod layer;
 pub mod network;
@@ -22,9 +27,11 @@ pub mod resize;
 pub mod shipped;
 pub mod swae;
 
-pub use card::{ModelCard, TrainingInfo, WeightsInfo};
+pub use card::{ModelCard, TrainingInfo, WeightsCard, WeightsInfo};
 pub use dense::{Mlp, MlpScratch};
+pub use embed::Embedded;
+pub use error::ModelError;
 pub use layer::{LayerSpec, Shape};
-pub use network::{ModelError, Network};
+pub use network::Network;
 pub use patch::PatchEncoder;
 pub use swae::{SWAE_SOURCE, SwaeSource};

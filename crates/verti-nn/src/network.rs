@@ -1,19 +1,9 @@
 //! A feed-forward network built from a model card and its weights.
 
 use crate::card::{CARD_FORMAT, ModelCard, WeightsInfo, fnv1a64};
+pub use crate::error::ModelError;
 use crate::layer::{LayerSpec, Shape};
-use std::path::{Path, PathBuf};
-
-#[derive(Debug, thiserror::Error)]
-pub enum ModelError {
-    #[error("{path}: {message}")]
-    Invalid { path: PathBuf, message: String },
-    #[error("{path}: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-}
+use std::path::Path;
 
 /// A network ready for inference: the card, and each layer's parameters and input shape.
 #[derive(Clone, Debug)]
@@ -80,22 +70,7 @@ impl Network {
                 card.weights.floats
             )));
         }
-        if offset.checked_mul(4) != Some(weights.len()) {
-            return Err(bad(format!(
-                "weights file {} has {} bytes, expected {} ({offset} f32 values): truncated or not this model's",
-                card.weights.file,
-                weights.len(),
-                // in u128: a count from the card may be near usize::MAX
-                4 * offset as u128,
-            )));
-        }
-        let digest = format!("{:016x}", fnv1a64(weights));
-        if digest != card.weights.fnv1a64 {
-            return Err(bad(format!(
-                "weights file {} has digest {digest}, the card says {}: the file does not belong to this card",
-                card.weights.file, card.weights.fnv1a64
-            )));
-        }
+        card.weights.check(weights, origin)?;
         let params: Vec<f32> = weights
             .chunks_exact(4)
             .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
@@ -248,12 +223,9 @@ fn check_size(len: Option<usize>, what: &str, shape: Shape) -> Result<(), String
     }
 }
 
-/// Parses a card, naming the file and the problem.
+/// Parses a network's card, naming the file and the problem.
 pub fn parse_card(text: &str, path: &Path) -> Result<ModelCard, ModelError> {
-    serde_norway::from_str(text).map_err(|e| ModelError::Invalid {
-        path: path.to_path_buf(),
-        message: format!("not a model card: {e}"),
-    })
+    crate::card::parse(text, path)
 }
 
 fn params_to_bytes(params: &[f32]) -> Vec<u8> {

@@ -1,44 +1,22 @@
-//! The trained models that ship in the repository's `models/` directory, compiled into the
-//! binary so a fresh clone (and an installed wheel) needs no training and no file lookup.
+//! verti-nn's trained models that ship in the repository's `models/` directory, compiled in
+//! ([`crate::embed!`]).
 
-use crate::network::{ModelError, Network, parse_card};
+use crate::embed::Embedded;
+use crate::network::Network;
 use crate::patch::PatchEncoder;
 use crate::swae::SwaeFactory;
-use std::path::Path;
 use std::sync::{Arc, OnceLock};
 use verti_world::generate::sources::ElevationRegistry;
 
-/// A model shipped in `models/`: its card and weight bytes.
-struct Shipped {
-    card_path: &'static str,
-    card: &'static str,
-    weights: &'static [u8],
-}
+const SWAE_V1: Embedded = crate::embed!("swae-v1");
+const PATCH_V1: Embedded = crate::embed!("patch-v1");
 
-impl Shipped {
-    fn load(&self) -> Result<Network, ModelError> {
-        let path = Path::new(self.card_path);
-        Network::from_bytes(parse_card(self.card, path)?, self.weights, path)
-    }
-}
-
-const SWAE_V1: Shipped = Shipped {
-    card_path: "models/swae-v1.yaml",
-    card: include_str!("../../../models/swae-v1.yaml"),
-    weights: include_bytes!("../../../models/swae-v1.bin"),
-};
-
-const PATCH_V1: Shipped = Shipped {
-    card_path: "models/patch-v1.yaml",
-    card: include_str!("../../../models/patch-v1.yaml"),
-    weights: include_bytes!("../../../models/patch-v1.bin"),
-};
-
+/// The network of `model`, loaded once into `cell`.
 fn cached(
     cell: &'static OnceLock<Result<Arc<Network>, String>>,
-    model: &Shipped,
+    model: &Embedded,
 ) -> Result<Arc<Network>, String> {
-    cell.get_or_init(|| model.load().map(Arc::new).map_err(|e| e.to_string()))
+    cell.get_or_init(|| model.network().map(Arc::new).map_err(|e| e.to_string()))
         .clone()
 }
 

@@ -4,36 +4,15 @@
 
 use crate::policy::Policy;
 use crate::system::PolicySystem;
-use std::path::Path;
 use std::sync::{Arc, OnceLock};
-use verti_nn::Network;
-use verti_nn::network::parse_card;
+use verti_nn::{Embedded, embed};
 
-/// One shipped policy: its card and weights.
-struct Embedded {
-    path: &'static str,
-    card: &'static str,
-    weights: &'static [u8],
-}
-
-macro_rules! embedded {
-    ($stem:literal) => {
-        Embedded {
-            path: concat!("models/", $stem, ".yaml"),
-            card: include_str!(concat!("../../../models/", $stem, ".yaml")),
-            weights: include_bytes!(concat!("../../../models/", $stem, ".bin")),
-        }
-    };
-}
-
-const RL: Embedded = embedded!("rl-v1");
-const MCL: Embedded = embedded!("mcl-v1");
-const ACL: Embedded = embedded!("acl-v1");
+const RL: Embedded = embed!("rl-v1");
+const MCL: Embedded = embed!("mcl-v1");
+const ACL: Embedded = embed!("acl-v1");
 
 fn load(e: &Embedded) -> Result<Arc<Policy>, String> {
-    let path = Path::new(e.path);
-    let card = parse_card(e.card, path).map_err(|x| x.to_string())?;
-    let net = Network::from_bytes(card, e.weights, path).map_err(|x| x.to_string())?;
+    let net = e.network().map_err(|x| x.to_string())?;
     Policy::new(Arc::new(net)).map(Arc::new)
 }
 

@@ -173,10 +173,7 @@ impl VaData {
 
 fn cache_key(dir: &Path, dt: f64, encoder: &PatchEncoder, rows: usize) -> Result<u64> {
     let manifest = dir.join("manifest.yaml");
-    let text = std::fs::read(&manifest).map_err(|e| VaError::Io {
-        path: manifest,
-        source: e,
-    })?;
+    let text = std::fs::read(&manifest).map_err(|e| VaError::io(&manifest, e))?;
     let mut bytes = text;
     for v in encoder.network().params() {
         bytes.extend(v.to_le_bytes());

@@ -11,8 +11,6 @@
 //!   `fields` lays the basis fields out for the planner's rollouts (bit-identical, faster);
 //! * [`data`]: trajectories of a dataset with their terrain latents, split by world.
 
-use std::path::PathBuf;
-
 pub mod adapter;
 pub mod data;
 mod dims;
@@ -29,21 +27,8 @@ pub mod terrain;
 
 pub use model::{Example, Method, VaCard, VaModel};
 
-#[derive(Debug, thiserror::Error)]
-pub enum VaError {
-    #[error("{path}: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("{path}: {field}: {why}")]
-    Card {
-        path: PathBuf,
-        field: String,
-        why: String,
-    },
-    #[error("{0}")]
-    Data(String),
-}
+/// Errors of model files and training data: verti-nn's, the one error of every model (and
+/// verti-kino's `KinoError`).
+pub use verti_nn::ModelError as VaError;
 
 pub type Result<T> = std::result::Result<T, VaError>;

@@ -31,7 +31,8 @@ use crate::terrain::{ELEVATION_LATENT, SEMANTIC_LATENT, TERRAIN_DIM};
 use crate::{Result, VaError};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
+use verti_nn::WeightsCard;
 
 pub const VA_FORMAT: u32 = 1;
 
@@ -64,14 +65,9 @@ impl Method {
     }
 }
 
-/// The weights file a card points to.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct WeightsRef {
-    pub file: String,
-    pub floats: usize,
-    pub fnv1a64: String,
-}
+/// The weights file a card points to: the same record as a network card's, checked the same
+/// way ([`verti_nn::WeightsInfo::check`]).
+pub use verti_nn::WeightsInfo as WeightsRef;
 
 /// What training did.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -225,11 +221,7 @@ pub struct Example {
 impl VaModel {
     /// Checks a card against its weights.
     pub fn new(card: VaCard, params: &[f32], origin: &Path) -> Result<VaModel> {
-        let bad = |field: &str, why: String| VaError::Card {
-            path: origin.to_path_buf(),
-            field: field.to_string(),
-            why,
-        };
+        let bad = |field: &str, why: String| VaError::card(origin, field, why);
         if card.format != VA_FORMAT {
             return Err(bad(
                 "format",
@@ -310,10 +302,7 @@ impl VaModel {
 
     /// Reads a card and the weights file beside it.
     pub fn load(path: &Path) -> Result<VaModel> {
-        let io = |p: &Path, e: std::io::Error| VaError::Io {
-            path: p.to_path_buf(),
-            source: e,
-        };
+        let io = VaError::io;
         let text = std::fs::read_to_string(path).map_err(|e| io(path, e))?;
         let card = parse_card(&text, path)?;
         let wpath = path
@@ -324,26 +313,10 @@ impl VaModel {
         VaModel::from_bytes(card, &bytes, path)
     }
 
-    /// A card and its weight bytes (as compiled-in models come).
+    /// A card and its weight bytes (as compiled-in models come), checked against the count
+    /// and digest the card records.
     pub fn from_bytes(card: VaCard, bytes: &[u8], origin: &Path) -> Result<VaModel> {
-        let digest = format!("{:016x}", verti_nn::card::fnv1a64(bytes));
-        if digest != card.weights.fnv1a64 {
-            return Err(VaError::Card {
-                path: origin.to_path_buf(),
-                field: "weights.fnv1a64".into(),
-                why: format!(
-                    "{} has digest {digest}, the card says {}",
-                    card.weights.file, card.weights.fnv1a64
-                ),
-            });
-        }
-        if !bytes.len().is_multiple_of(4) {
-            return Err(VaError::Card {
-                path: origin.to_path_buf(),
-                field: "weights".into(),
-                why: format!("{} bytes is not a whole number of f32", bytes.len()),
-            });
-        }
+        card.weights.check(bytes, origin)?;
         let params: Vec<f32> = bytes
             .chunks_exact(4)
             .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
@@ -368,20 +341,17 @@ impl VaModel {
 
     /// Writes the card to `path` and the weights beside it (the card's digest is updated).
     pub fn save(&mut self, path: &Path) -> Result<()> {
-        let io = |p: PathBuf, e: std::io::Error| VaError::Io { path: p, source: e };
+        let io = VaError::io;
         let dir = path.parent().unwrap_or(Path::new("."));
-        std::fs::create_dir_all(dir).map_err(|e| io(dir.to_path_buf(), e))?;
+        std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
         let bytes: Vec<u8> = self.params().iter().flat_map(|v| v.to_le_bytes()).collect();
         self.card.weights.floats = bytes.len() / 4;
         self.card.weights.fnv1a64 = format!("{:016x}", verti_nn::card::fnv1a64(&bytes));
         let wpath = dir.join(&self.card.weights.file);
-        std::fs::write(&wpath, &bytes).map_err(|e| io(wpath, e))?;
-        let text = serde_norway::to_string(&self.card).map_err(|e| VaError::Card {
-            path: path.to_path_buf(),
-            field: "card".into(),
-            why: e.to_string(),
-        })?;
-        std::fs::write(path, text).map_err(|e| io(path.to_path_buf(), e))
+        std::fs::write(&wpath, &bytes).map_err(|e| io(&wpath, e))?;
+        let text =
+            serde_norway::to_string(&self.card).map_err(|e| VaError::card(path, "card", e))?;
+        std::fs::write(path, text).map_err(|e| io(path, e))
     }
 
     /// Multiply-adds of one predicted step (all fields, all RK4 stages).
@@ -602,11 +572,13 @@ pub(crate) fn held_inputs(
     rest
 }
 
+impl WeightsCard for VaCard {
+    fn weights_info(&self) -> &WeightsRef {
+        &self.weights
+    }
+}
+
 /// Parses a card, naming the file and the problem.
 pub fn parse_card(text: &str, path: &Path) -> Result<VaCard> {
-    serde_norway::from_str(text).map_err(|e| VaError::Card {
-        path: path.to_path_buf(),
-        field: "card".into(),
-        why: e.to_string(),
-    })
+    verti_nn::card::parse(text, path)
 }

@@ -2,18 +2,16 @@
 //! [32, 32]), compiled in so a fresh clone plans without training (`verti learn va --hidden
 //! 32,32 --out models/va-small-v1.yaml` reproduces it).
 
-use crate::model::{VaModel, parse_card};
-use std::path::Path;
+use crate::model::{VaCard, VaModel};
 use std::sync::Arc;
+use verti_nn::{Embedded, embed};
 
-const CARD: &str = include_str!("../../../models/va-small-v1.yaml");
-const WEIGHTS: &[u8] = include_bytes!("../../../models/va-small-v1.bin");
+const VA_SMALL_V1: Embedded = embed!("va-small-v1");
 
 /// The shipped `va-small-v1`.
 pub fn va_small_v1() -> Result<Arc<VaModel>, String> {
-    let origin = Path::new("models/va-small-v1.yaml");
-    let card = parse_card(CARD, origin).map_err(|e| e.to_string())?;
-    VaModel::from_bytes(card, WEIGHTS, origin)
+    let (card, weights) = VA_SMALL_V1.checked::<VaCard>().map_err(|e| e.to_string())?;
+    VaModel::from_bytes(card, weights, VA_SMALL_V1.origin())
         .map(Arc::new)
         .map_err(|e| e.to_string())
 }
