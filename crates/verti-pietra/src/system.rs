@@ -4,7 +4,8 @@
 //!
 //! Defaults follow the paper where it speaks (1024 rollouts, 5 s horizon, 10 Hz, α = 0.5 as on
 //! the robot, roll/pitch limit 30°) and verti's MPPI where it does not (speed 3 m/s on the
-//! benchmark's 120 m tasks; the paper's 1 m/s is `speed=1`, as `verti pietra navigate` uses).
+//! benchmark's 120 m tasks; the paper's 1 m/s is `speed=1`; `verti pietra navigate` drives at 2
+//! m/s, where the HMMWV does not stall on rock).
 
 use crate::dataset::WheelLayout;
 use crate::model::TravModel;
