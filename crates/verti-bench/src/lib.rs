@@ -1,6 +1,17 @@
 //! # verti-bench
 //!
-//! The benchmark around the simulator:
+//! The benchmark around the simulator. Evaluating systems on task sets is three separate
+//! parts, each only using the ones listed before it:
+//!
+//! 1. [`run`], the bookkeeping of a run directory: its lock, resuming, what a run is by content
+//!    (`run.json`, [`identity`]), the results file, and splitting a run into shards and merging
+//!    them back ([`shard`]).
+//! 2. [`eval`], the trial loop: the tasks of a selection run in parallel, deterministically,
+//!    one result line appended per finished trial (it opens the directory through `run`).
+//! 3. [`report`]: finished runs read back (through `run`'s public types) and summarised as the
+//!    paper's tables and figures.
+//!
+//! [`replay`] re-runs one trial of a finished run. Below them:
 //!
 //! * [`system`]: the [`MobilitySystem`] interface. Systems see an [`Observation`] and return an
 //!   [`Action`]; they never touch simulator internals. A [`SystemRegistry`] builds them by
@@ -18,15 +29,11 @@
 //! * [`features`]: the one schema of named state features (step logs, state vectors).
 //! * [`path`]: following the global path (local goal, heading error), for systems and rewards.
 //! * [`metrics`]: per-trial metrics and their aggregation into the paper's Table I and Fig. 6.
-//! * [`eval`]: parallel, deterministic, resumable evaluation over task ranges; [`shard`]
-//!   splits one over machines and joins the pieces.
 //! * [`perception`]: seeded perception noise on what systems observe (never on the physics).
 
 pub mod episode;
 pub mod eval;
-mod eval_error;
 pub mod features;
-pub mod identity;
 pub mod metrics;
 mod nullable;
 pub mod observation;
@@ -38,10 +45,21 @@ pub mod replay;
 pub mod report;
 mod result;
 mod rules;
-pub mod shard;
+pub mod run;
 pub mod speed;
 pub mod system;
 pub mod trial;
+
+// Long-standing paths of run bookkeeping, kept for the crates that use them.
+pub use run::identity;
+
+/// Splitting one evaluation over machines ([`Shard`](run::shard::Shard)) and joining the
+/// finished shards ([`join`](run::merge::join)): the long-standing path of [`run::shard`] and
+/// [`run::merge`] together.
+pub mod shard {
+    pub use crate::run::merge::{Joined, join};
+    pub use crate::run::shard::Shard;
+}
 
 pub use episode::{
     EpisodeConfig, Outcome, Rules, StartMode, Termination, TrialResult, run_episode,

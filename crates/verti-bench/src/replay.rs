@@ -3,8 +3,8 @@
 //! the recorded settings is the trial).
 
 use crate::episode::{EpisodeConfig, TrialResult};
-use crate::eval::{RESULTS_FILE, RUN_FILE, read_results};
-use crate::identity::RunRecord;
+use crate::run::identity::RunRecord;
+use crate::run::{RESULTS_FILE, RUN_FILE, read_results};
 use crate::system::{MobilitySystem, SystemRegistry};
 use std::path::Path;
 use std::sync::Arc;
@@ -67,7 +67,7 @@ pub fn prepare(
         None => vehicle_by_name(&run.vehicle)?,
     };
     if let Some(d) = &record.vehicle_digest
-        && *d != crate::identity::vehicle_digest(&vehicle)
+        && *d != crate::run::identity::vehicle_digest(&vehicle)
     {
         return Err(format!(
             "{}: vehicle `{}` is not the one the run drove (its contents changed since)",
@@ -84,7 +84,7 @@ pub fn prepare(
         .map(Arc::new)
         .collect();
     if let Some(d) = &record.worlds_digest
-        && *d != crate::identity::set_digest(&set)
+        && *d != crate::run::identity::set_digest(&set)
     {
         return Err(format!(
             "`{}` no longer holds the worlds the run in {} used (their contents differ); replay where the run was made, or restore the set",

@@ -3,8 +3,8 @@
 
 use super::loaded::{Loaded, LoadedFile, ReportError};
 use crate::episode::TrialResult;
-use crate::eval::{RESULTS_FILE, RUN_FILE, read_results};
-use crate::identity::RunRecord;
+use crate::run::identity::RunRecord;
+use crate::run::{RESULTS_FILE, RUN_FILE, read_results};
 use std::path::{Path, PathBuf};
 
 /// The results files a path stands for: a file itself; a directory's `results.jsonl`; or,

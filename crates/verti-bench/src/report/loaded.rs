@@ -5,8 +5,8 @@
 //! each other. `crate::report` re-exports them.
 
 use crate::episode::TrialResult;
-use crate::eval::{EvalError, RESULTS_FILE};
-use crate::identity::RunRecord;
+use crate::run::identity::RunRecord;
+use crate::run::{EvalError, RESULTS_FILE};
 use std::path::PathBuf;
 
 /// Why results could not be loaded.

@@ -44,6 +44,10 @@
 //! * `writers`: [`markdown`] and [`html`].
 //! * `fixtures` (tests only): the sample trials the tests share.
 //!
+//! Runs are read through the run bookkeeping's public types (`crate::run`: the results file,
+//! `run.json`), never through the trial loop (`crate::eval`): a report only needs what a run
+//! left on disk.
+//!
 //! Tests live with the code they test; the ones spanning several of these files are here.
 
 mod aggregate;

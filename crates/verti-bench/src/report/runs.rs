@@ -6,7 +6,7 @@
 
 use super::loaded::{LoadedFile, ReportError};
 use crate::episode::TrialResult;
-use crate::identity::RunRecord;
+use crate::run::identity::RunRecord;
 use std::collections::{BTreeMap, HashMap};
 
 /// The settings of a run that its results depend on, as `name → value` text (parameters as

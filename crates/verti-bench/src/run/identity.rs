@@ -7,8 +7,8 @@
 //! of the world set's contents and of the vehicle spec next to the names, and a resume that
 //! differs is refused with the settings that differ, one by one.
 
+use super::error::EvalError;
 use crate::episode::StartMode;
-use crate::eval_error::EvalError;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::sync::Arc;
