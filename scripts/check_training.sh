@@ -6,8 +6,10 @@
 #   bash scripts/check_training.sh --update   # write them (only after a deliberate change)
 #
 # Run it before and after a refactor of training code: the digests must not move. Training is
-# deterministic for a seed regardless of thread count, so the digests are machine-independent
-# on one platform (x86-64, the flex backend); they are not a cross-platform promise.
+# deterministic for a seed, but burn's CPU matrix products pick their SIMD kernels at run time
+# (gemm: AVX-512, AVX2, ...), so the committed digests hold on a CPU like the one that wrote
+# them (an AVX-512 x86-64); elsewhere, write digests with --update on the old commit first.
+# That is also why CI does not run it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 REF=scripts/training_digests.txt

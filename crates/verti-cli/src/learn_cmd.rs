@@ -42,9 +42,9 @@ mod with_burn {
     use super::*;
     use crate::learn_args::AutoencoderArgs;
     use crate::progress::bar;
-    use verti_learn::commands::{RunSettings, Trained, learn_patch, learn_swae};
-    use verti_learn::patches::PatchSettings;
-    use verti_learn::swae::SwaeConfig;
+    use verti_nn::train::commands::{RunSettings, Trained, learn_patch, learn_swae};
+    use verti_nn::train::patches::PatchSettings;
+    use verti_nn::train::swae::SwaeConfig;
 
     fn config(a: &AutoencoderArgs, side: usize, defaults: SwaeConfig) -> SwaeConfig {
         SwaeConfig {
@@ -95,7 +95,7 @@ mod with_burn {
     }
 
     pub fn run(cmd: LearnCommand) -> Result<(), String> {
-        let device = verti_learn::training_device();
+        let device = verti_nn::train::device();
         match cmd {
             LearnCommand::Kino(a) => crate::learn_kino::run(&a, &command_line(), &device),
             LearnCommand::Rl(a) => crate::learn_rl::run(&a, &command_line(), &device),
@@ -113,7 +113,7 @@ mod with_burn {
         Patch(PatchArgs),
     }
 
-    fn run_autoencoder(cmd: Autoencoder, device: &verti_learn::Device) -> Result<(), String> {
+    fn run_autoencoder(cmd: Autoencoder, device: &verti_nn::train::Device) -> Result<(), String> {
         let (run, data) = match &cmd {
             Autoencoder::Swae(a) => (
                 config(

@@ -5,10 +5,10 @@ use crate::progress::bar;
 use std::path::PathBuf;
 use verti_kino::KinoKind;
 use verti_kino::features::OUTPUT_NAMES;
-use verti_learn::Device;
-use verti_learn::kino::KinoConfig;
-use verti_learn::kino_command::{KinoRun, draw_curve, learn_kino};
-use verti_learn::trav::{TravRun, learn_trav};
+use verti_kino::train::kino::KinoConfig;
+use verti_kino::train::kino_command::{KinoRun, draw_curve, learn_kino};
+use verti_kino::train::trav::{TravRun, learn_trav};
+use verti_nn::train::Device;
 
 /// Progress of a training run: the bar, and plain lines every `eval_every` steps where
 /// stderr is not a terminal (logs of long runs).

@@ -16,16 +16,16 @@ use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use verti_learn::Device;
-use verti_learn::pietra::bench::{
-    Grid, RunScores, density_markdown, figure6, markdown, runs_csv, score, tables, wall_by_method,
-};
-use verti_learn::pietra::data::PietraData;
-use verti_learn::pietra::model::Method;
-use verti_learn::pietra::train::RunConfig;
+use verti_nn::train::Device;
 use verti_pietra::dataset::DataConfig;
 use verti_pietra::maps;
 use verti_pietra::prior::PriorConfig;
+use verti_pietra::train::bench::{
+    Grid, RunScores, density_markdown, figure6, markdown, runs_csv, score, tables, wall_by_method,
+};
+use verti_pietra::train::data::PietraData;
+use verti_pietra::train::fit::RunConfig;
+use verti_pietra::train::model::Method;
 
 fn methods(spec: &str) -> Result<Vec<Method>, String> {
     if spec == "all" {
@@ -132,7 +132,7 @@ fn train_one(a: &PietraArgs, command: &str, device: &Device) -> Result<(), Strin
     let cfg = RunConfig {
         method,
         lr: a.lr.unwrap_or(lr),
-        weights: verti_learn::pietra::model::LossWeights {
+        weights: verti_pietra::train::model::LossWeights {
             physics: a.kappa.unwrap_or(kappa),
             entropy: a.entropy.unwrap_or(entropy),
         },
@@ -150,7 +150,7 @@ fn train_one(a: &PietraArgs, command: &str, device: &Device) -> Result<(), Strin
         .unwrap_or("pietra-v1")
         .to_string();
     let data = build_data(a, &mut |line| println!("{line}"))?;
-    let info = verti_learn::pietra::export::ExportInfo {
+    let info = verti_pietra::train::export::ExportInfo {
         name,
         command: command.to_string(),
         data: format!(
@@ -166,7 +166,7 @@ fn train_one(a: &PietraArgs, command: &str, device: &Device) -> Result<(), Strin
             maps::Split::Test.indices()
         ),
     };
-    let model = verti_learn::pietra::export::train_model(&data, &cfg, &info, device)?;
+    let model = verti_pietra::train::export::train_model(&data, &cfg, &info, device)?;
     model.save(&out)?;
     println!(
         "wrote {} ({} networks beside it); {:?}; {:.1} s",

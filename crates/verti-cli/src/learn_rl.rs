@@ -5,9 +5,9 @@ use crate::learn_args::{CurvesArgs, RlArgs};
 use crate::progress::bar;
 use std::path::PathBuf;
 use std::sync::Arc;
-use verti_learn::Device;
-use verti_learn::ppo::PpoConfig;
-use verti_learn::rl::{CurriculumKind, RlSettings, learn_rl};
+use verti_nn::train::Device;
+use verti_policy::train::ppo::PpoConfig;
+use verti_policy::train::rl::{CurriculumKind, RlSettings, learn_rl};
 
 /// Refuses the evaluation set: policies train and validate on other seeds.
 fn check_not_evaluation(set: &str, flag: &str) -> Result<(), String> {
@@ -73,8 +73,8 @@ pub fn run(a: &RlArgs, command: &str, device: &Device) -> Result<(), String> {
     let quiet = !std::io::IsTerminal::is_terminal(&std::io::stderr());
     let started = std::time::Instant::now();
     let mut last_val = f64::NAN;
-    let mut progress = |u: &verti_learn::ppo::UpdateStats,
-                        point: Option<&verti_learn::rl::CurvePoint>,
+    let mut progress = |u: &verti_policy::train::ppo::UpdateStats,
+                        point: Option<&verti_policy::train::rl::CurvePoint>,
                         status: &str| {
         let t = started.elapsed().as_secs_f64();
         pb.set_position((t as u64).min(budget_s));
@@ -139,13 +139,13 @@ pub fn curves(a: &CurvesArgs) -> Result<(), String> {
             .rfind("-s")
             .map_or(name.trim_end_matches("-log.csv"), |i| &name[..i])
             .to_string();
-        let points = verti_learn::rl::read_log(path)?;
+        let points = verti_policy::train::rl::read_log(path)?;
         match groups.iter_mut().find(|(g, _)| *g == group) {
             Some((_, runs)) => runs.push(points),
             None => groups.push((group, vec![points])),
         }
     }
-    let finals = verti_learn::rl::draw_comparison(&groups, &a.title, &a.out)?;
+    let finals = verti_policy::train::rl::draw_comparison(&groups, &a.title, &a.out)?;
     for ((name, runs), (_, last, area)) in groups.iter().zip(&finals) {
         let each: Vec<String> = runs
             .iter()

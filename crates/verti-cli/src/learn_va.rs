@@ -3,15 +3,15 @@
 use crate::learn_args::VaArgs;
 use crate::progress::bar;
 use std::path::PathBuf;
-use verti_learn::Device;
-use verti_learn::va::batch::Sampling;
-use verti_learn::va::bench::{self, BenchConfig};
-use verti_learn::va::command::{VaRun, learn_va};
-use verti_learn::va::net::NetSpec;
-use verti_learn::va::report;
-use verti_learn::va::train::TrainConfig;
+use verti_nn::train::Device;
 use verti_va::Method;
 use verti_va::lsq::LAMBDA;
+use verti_va::train::batch::Sampling;
+use verti_va::train::bench::{self, BenchConfig};
+use verti_va::train::command::{VaRun, learn_va};
+use verti_va::train::fit::TrainConfig;
+use verti_va::train::net::NetSpec;
+use verti_va::train::report;
 
 /// The model step (paper: RK4 over Δt = 0.1 s), full-scale seconds.
 pub const DT: f64 = 0.1;
@@ -130,7 +130,7 @@ fn adapt_to_worlds(a: &VaArgs, set: &str, device: &Device) -> Result<(), String>
         let name = format!("w{:03}", w.meta.index);
         let started = std::time::Instant::now();
         let sim = verti_sim::Sim::new(w, &spec).map_err(|e| format!("{}: {e}", w.meta.name))?;
-        let mut adapted = verti_learn::va::adapt::adapt_to_world(
+        let mut adapted = verti_va::train::adapt::adapt_to_world(
             &model,
             w,
             std::sync::Arc::new(sim),

@@ -1,8 +1,8 @@
 //! verti's learned models at inference time, without a learning framework.
 //!
-//! Training happens in `verti-learn` (burn); what the benchmark needs to *run* a trained model
-//! lives here, in plain Rust, so that world generation, evaluation and the Python package never
-//! build burn:
+//! Training happens in `train`, behind the `train` feature (burn); what the benchmark needs to
+//! *run* a trained model lives here, in plain Rust, so that world generation, evaluation and the
+//! Python package never build burn:
 //!
 //! * [`Network`]: feed-forward networks (linear, conv, transposed conv, activations) read from
 //!   a model card ([`ModelCard`], YAML) and a raw f32 weight file, evaluated with fixed-order
@@ -13,7 +13,9 @@
 //! * [`embed`]: how every crate compiles in the trained models that ship in the repository
 //!   (`models/`), checked against their cards ([`embed!`]), with the one error of model files,
 //!   [`ModelError`];
-//! * [`shipped`]: verti-nn's own shipped models (`swae-v1`, `patch-v1`).
+//! * [`shipped`]: verti-nn's own shipped models (`swae-v1`, `patch-v1`);
+//! * `train` (feature `train`, burn): the network every family trains with (`train::seq`) and the
+//!   SWAE and patch-encoder trainings.
 
 pub mod card;
 pub mod dense;
@@ -26,6 +28,8 @@ pub mod patch;
 pub mod resize;
 pub mod shipped;
 pub mod swae;
+#[cfg(feature = "train")]
+pub mod train;
 
 pub use card::{ModelCard, TrainingInfo, WeightsCard, WeightsInfo};
 pub use dense::{Mlp, MlpScratch};

@@ -1,7 +1,7 @@
 //! EMD² between PMFs on ordered bins, its expectation under a Dirichlet (UEMD², eq. 13) and the
 //! Dirichlet entropy regulariser, with the special functions they need.
 //!
-//! These are the f64 reference implementations: the trainer in `verti-learn` re-implements them on
+//! These are the f64 reference implementations: the trainer (`train::special`) re-implements them on
 //! tensors and checks itself against these, and evaluation reports EMD² with them (spec §A.4).
 
 use crate::bins::{B, Pmf};

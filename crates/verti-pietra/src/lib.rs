@@ -1,5 +1,6 @@
 //! PIETRA (Cai et al., RA-L 2025): physics-informed evidential traversability, in plain Rust.
-//! Training lives in `verti-learn` (burn); everything a planner and the benchmark need is here.
+//! Training is the `train` module behind the `train` feature (burn); everything a planner and the
+//! benchmark need is here, without it.
 //!
 //! * [`bins`]: the B = 12 bins of each traversability parameter and one-hot targets;
 //! * [`emd`]: EMD², its expectation under a Dirichlet (UEMD², closed form) and Dirichlet entropy;
@@ -30,3 +31,5 @@ pub mod planner;
 pub mod prior;
 pub mod shipped;
 pub mod system;
+#[cfg(feature = "train")]
+pub mod train;

@@ -3,7 +3,7 @@
 //! four decoders, evidence scaler — as verti-nn MLPs. `verti learn pietra` writes it; CVaR maps
 //! and the planner read it.
 //!
-//! The computation is the one `verti-learn` trains (tested against it there): z = enc(o / s),
+//! The computation is the one `train` (feature `train`) trains (tested against it there): z = enc(o / s),
 //! p_φ,k = softmax(dec_k(z)), log p(z) through the radial flow, n_k = exp(clamp(log p(z) +
 //! log N)) · sigmoid(scale_k(z)), β_k = n_prior p_prior,k + n_k p_φ,k, and the expected PMF
 //! β_k / Σβ_k (eq. 11). Methods without evidence predict p_φ,k.

@@ -1,6 +1,6 @@
 //! # verti-policy
 //!
-//! Driving policies trained by reinforcement learning (`verti learn rl`, in `verti-learn`) at
+//! Driving policies trained by reinforcement learning (`verti learn rl`: the `train` module, feature `train`) at
 //! inference time, in plain Rust, so that evaluation and the Python package never build burn:
 //!
 //! * [`inputs`]: what a policy observes (a heading-aligned elevation patch, the heading error
@@ -15,5 +15,7 @@ pub mod inputs;
 pub mod policy;
 pub mod shipped;
 pub mod system;
+#[cfg(feature = "train")]
+pub mod train;
 
 pub use policy::Policy;

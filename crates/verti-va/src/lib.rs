@@ -1,6 +1,6 @@
 //! VertiAdaptor (Xu et al.): kinodynamics as a linear combination of neural-ODE basis
 //! functions whose coefficients are identified online by least squares, in plain Rust.
-//! Training lives in `verti-learn` (`verti learn va`); everything needed to adapt, predict
+//! Training is the `train` module behind the `train` feature (burn; `verti learn va`); everything needed to adapt, predict
 //! and plan with a trained model is here.
 //!
 //! * [`terrain`]: the elevation and semantic latents under the vehicle;
@@ -24,6 +24,8 @@ pub mod rk4;
 pub mod shipped;
 pub mod system;
 pub mod terrain;
+#[cfg(feature = "train")]
+pub mod train;
 
 pub use model::{Example, Method, VaCard, VaModel};
 
