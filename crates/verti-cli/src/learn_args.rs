@@ -39,7 +39,7 @@ pub struct VaArgs {
     pub lr_final: f64,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Model card to write (default models/METHOD-v1.yaml; weights, log and curve beside it).
+    /// Model card to write (default crates/verti-va/models/METHOD-v1.yaml; weights, log and curve beside it).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Validation every this many steps.
@@ -52,8 +52,8 @@ pub struct VaArgs {
     /// Benchmark: test data (random exploration on unseen worlds, several trials per world).
     #[arg(long, default_value = "data/va-test-s3")]
     pub test: PathBuf,
-    /// Benchmark: LABEL=CARD pairs, comma-separated (default: va, node, maml, mlp from models/
-    /// and the three ablations from results/va-bench/models/).
+    /// Benchmark: LABEL=CARD pairs, comma-separated (default: va, node, maml, mlp from
+    /// crates/verti-va/models/ and the three ablations from results/va-bench/models/).
     #[arg(long, value_delimiter = ',')]
     pub models: Vec<String>,
     /// Benchmark: adaptation trajectories per world (the rest are scored).
@@ -77,7 +77,7 @@ pub struct VaArgs {
     /// World indices of --adapt-to (e.g. 1,2,4), default all.
     #[arg(long, value_delimiter = ',')]
     pub adapt_worlds: Vec<u32>,
-    #[arg(long, default_value = "models/maml-v1.yaml")]
+    #[arg(long, default_value = "crates/verti-va/models/maml-v1.yaml")]
     pub adapt_model: PathBuf,
     #[arg(long, default_value = "results/va-nav/maml")]
     pub adapt_out: PathBuf,
@@ -109,7 +109,7 @@ pub struct PietraArgs {
     /// Training seed of the model.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Model card to write (default models/METHOD-v1.yaml; networks beside it).
+    /// Model card to write (default crates/verti-pietra/models/METHOD-v1.yaml; networks beside it).
     #[arg(long)]
     pub model_out: Option<PathBuf>,
     /// Methods to train: all, or a list of pietra, pi, vanilla, evora, upi-only, pp-only.
@@ -184,7 +184,7 @@ pub struct RlArgs {
     pub eval_every: u64,
     #[arg(long, default_value = "hmmwv")]
     pub vehicle: String,
-    /// Policy card to write (default models/SYSTEM-v1.yaml; weights, curve and log beside it).
+    /// Policy card to write (default crates/verti-policy/models/SYSTEM-v1.yaml; weights, curve and log beside it).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Parallel environments.
@@ -224,7 +224,7 @@ pub struct KinoArgs {
     /// Validation dataset, driven on other worlds (e.g. verti-100-s2).
     #[arg(long, default_value = "data/random-s2")]
     pub val: PathBuf,
-    /// Model card to write (default models/MODEL-v1.yaml; networks and curve beside it).
+    /// Model card to write (default crates/verti-kino/models/MODEL-v1.yaml; networks and curve beside it).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Model step, full-scale seconds (a multiple of the data's row period).
@@ -293,7 +293,7 @@ pub struct SwaeArgs {
     #[arg(long, default_value = "../shared/verti-bench-data/elev_maps")]
     pub data: PathBuf,
     /// Model card to write (weights and learning curve beside it).
-    #[arg(long, default_value = "models/swae-v1.yaml")]
+    #[arg(long, default_value = "crates/verti-nn/models/swae-v1.yaml")]
     pub out: PathBuf,
     /// Share of the maps held out for validation.
     #[arg(long, default_value_t = 0.1)]
@@ -317,7 +317,7 @@ pub struct PatchArgs {
     #[arg(long, default_value_t = 2.0)]
     pub height_scale: f64,
     /// Model card to write (weights and learning curve beside it).
-    #[arg(long, default_value = "models/patch-v1.yaml")]
+    #[arg(long, default_value = "crates/verti-nn/models/patch-v1.yaml")]
     pub out: PathBuf,
     #[command(flatten)]
     pub train: AutoencoderArgs,

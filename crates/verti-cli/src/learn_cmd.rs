@@ -1,4 +1,5 @@
-//! `verti learn`: trains the models that ship in `models/`. Training needs burn, which only
+//! `verti learn`: trains the models that ship in the family crates' `models/` folders.
+//! Training needs burn, which only
 //! builds with the `learn` feature (`cargo build --release -p verti-cli --features learn`), so
 //! the classical benchmark never pays for it; without the feature these commands explain how
 //! to get it.

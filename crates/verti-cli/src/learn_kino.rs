@@ -52,7 +52,7 @@ fn run_trav(a: &KinoArgs, command: &str, device: &Device) -> Result<(), String> 
     let out = a
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from("models/tnt-v1.yaml"));
+        .unwrap_or_else(|| PathBuf::from("crates/verti-kino/models/tnt-v1.yaml"));
     let name = out
         .file_stem()
         .and_then(|s| s.to_str())
@@ -123,7 +123,7 @@ pub fn run(a: &KinoArgs, command: &str, device: &Device) -> Result<(), String> {
     let out = a
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("models/{name}.yaml")));
+        .unwrap_or_else(|| PathBuf::from(format!("crates/verti-kino/models/{name}.yaml")));
     let name = out
         .file_stem()
         .and_then(|s| s.to_str())

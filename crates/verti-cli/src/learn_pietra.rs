@@ -140,10 +140,12 @@ fn train_one(a: &PietraArgs, command: &str, device: &Device) -> Result<(), Strin
         steps: a.steps,
         batch: 256,
     };
-    let out = a
-        .model_out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("models/{}-v1.yaml", method.name())));
+    let out = a.model_out.clone().unwrap_or_else(|| {
+        PathBuf::from(format!(
+            "crates/verti-pietra/models/{}-v1.yaml",
+            method.name()
+        ))
+    });
     let name = out
         .file_stem()
         .and_then(|s| s.to_str())

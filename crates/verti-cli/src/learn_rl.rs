@@ -30,10 +30,12 @@ pub fn run(a: &RlArgs, command: &str, device: &Device) -> Result<(), String> {
             "--worlds and --val-worlds must differ (validation needs unseen worlds)".into(),
         );
     }
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("models/{}-v1.yaml", curriculum.system())));
+    let out = a.out.clone().unwrap_or_else(|| {
+        PathBuf::from(format!(
+            "crates/verti-policy/models/{}-v1.yaml",
+            curriculum.system()
+        ))
+    });
     let vehicle = load_vehicle(&a.vehicle).map_err(|e| e.to_string())?;
     let train = load_set_with_progress(&a.worlds, 1.0).map_err(|e| e.to_string())?;
     let val = load_set_with_progress(&a.val_worlds, 1.0).map_err(|e| e.to_string())?;

@@ -41,10 +41,10 @@ pub fn config_of(a: &VaArgs) -> Result<TrainConfig, String> {
 
 /// The models the benchmark runs by default.
 const DEFAULT_MODELS: [(&str, &str); 7] = [
-    ("va", "models/va-v1.yaml"),
-    ("node", "models/node-v1.yaml"),
-    ("maml", "models/maml-v1.yaml"),
-    ("mlp", "models/mlp-v1.yaml"),
+    ("va", "crates/verti-va/models/va-v1.yaml"),
+    ("node", "crates/verti-va/models/node-v1.yaml"),
+    ("maml", "crates/verti-va/models/maml-v1.yaml"),
+    ("mlp", "crates/verti-va/models/mlp-v1.yaml"),
     (
         "va-no-semantics",
         "results/va-bench/models/va-no-semantics.yaml",
@@ -181,7 +181,7 @@ pub fn run(a: &VaArgs, command: &str, device: &Device) -> Result<(), String> {
     let out = a
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("models/{}-v1.yaml", a.method)));
+        .unwrap_or_else(|| PathBuf::from(format!("crates/verti-va/models/{}-v1.yaml", a.method)));
     let run = VaRun {
         data: a.data.clone(),
         val: a.val.clone(),

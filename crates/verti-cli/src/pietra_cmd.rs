@@ -44,7 +44,7 @@ pub struct NavigateArgs {
     pub methods: Vec<String>,
     /// Folder with the models `evora-v1.yaml`, `pi-v1.yaml`, `vanilla-v1.yaml` (and
     /// `pietra-v1.yaml`; the shipped one is used if absent).
-    #[arg(long, default_value = "models")]
+    #[arg(long, default_value = "crates/verti-pietra/models")]
     pub models: PathBuf,
     /// Maximum speed, m/s. The paper's robot crawled at 1 m/s; the HMMWV stalls on rock at that
     /// speed (a first look at 10 test tasks with the physics prior: 4 reached at 1 m/s, 9 at 2

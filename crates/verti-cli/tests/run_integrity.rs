@@ -209,7 +209,7 @@ fn a_merge_needs_every_shard_and_keeps_their_step_logs() {
 #[test]
 fn a_resume_checks_the_model_files_by_content() {
     let root = tmp("integrity", "models");
-    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../verti-policy/models");
     let copy = |card: &str| {
         for ext in ["yaml", "bin"] {
             std::fs::copy(

@@ -262,7 +262,7 @@ pub fn parse_card(text: &str, path: &Path) -> Result<KinoCard> {
             path,
             "card",
             "this is a network card (one of a model's networks); pass the model's own card \
-             (e.g. models/mppi6-v1.yaml), which lists its networks",
+             (e.g. crates/verti-kino/models/mppi6-v1.yaml), which lists its networks",
         ));
     }
     serde_norway::from_str(text).map_err(|e| {

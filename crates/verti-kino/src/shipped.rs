@@ -1,4 +1,4 @@
-//! The trained kinodynamic models that ship in `models/`, compiled into the binary so a fresh
+//! The trained kinodynamic models that ship in this crate's `models/`, compiled into the binary so a fresh
 //! clone plans with them without training (`verti learn kino --model NAME` reproduces each).
 
 use crate::card::{KinoFile, parse_card};

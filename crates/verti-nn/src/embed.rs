@@ -1,6 +1,6 @@
-//! Models compiled into the binary: how every crate ships its trained models from the
-//! repository's `models/` directory, so a fresh clone (and an installed wheel) needs no training
-//! and no file lookup.
+//! Models compiled into the binary: how every family crate ships its trained models from its
+//! own `models/` directory (`crates/NAME/models/`), so a fresh clone (and an installed wheel)
+//! needs no training and no file lookup.
 //!
 //! [`embed!`](crate::embed!) compiles a card in, with the weights file beside it (`NAME.bin`)
 //! or, for a composite card (a kinodynamic model's, PIETRA's), the cards and weights of the
@@ -8,7 +8,7 @@
 //! against the count and digest the card records ([`WeightsInfo::check`], the check files on
 //! disk pass too); [`Embedded::network`] builds a network from them and [`Embedded::part`]
 //! finds a composite card's part. Errors are [`ModelError`]s that name the card's path in the
-//! repository (`models/NAME.yaml`).
+//! repository (`crates/CRATE/models/NAME.yaml`).
 
 use crate::card::{ModelCard, WeightsCard, WeightsInfo, parse};
 use crate::error::ModelError;
@@ -18,7 +18,8 @@ use std::path::Path;
 /// A model card compiled in with [`embed!`](crate::embed!), and what it brings with it.
 #[derive(Clone, Copy, Debug)]
 pub struct Embedded {
-    /// The card's path in the repository, `models/NAME.yaml`: it names the model in errors.
+    /// The card's path in the repository, `crates/CRATE/models/NAME.yaml`: it names the model in
+    /// errors.
     pub path: &'static str,
     /// The card's text.
     pub card: &'static str,
@@ -29,20 +30,21 @@ pub struct Embedded {
     pub parts: &'static [Embedded],
 }
 
-/// Compiles a model card of the repository's `models/` directory into the calling crate (which
-/// lives in `crates/NAME`), as an [`Embedded`]:
+/// Compiles a model card of the calling crate's `models/` directory (`crates/CRATE/models/`)
+/// into it, as an [`Embedded`]:
 ///
-/// * `embed!("swae-v1")`: `models/swae-v1.yaml` and its weights, `models/swae-v1.bin`;
+/// * `embed!("swae-v1")` in verti-nn: `crates/verti-nn/models/swae-v1.yaml` and its weights,
+///   `crates/verti-nn/models/swae-v1.bin`;
 /// * `embed!("tal-v1", ["tal-v1.encoder", "tal-v1.gate"])`: the composite card
-///   `models/tal-v1.yaml` and the listed parts, each `embed!`ded with its weights.
+///   `crates/verti-kino/models/tal-v1.yaml` and the listed parts, each `embed!`ded with its weights.
 #[macro_export]
 macro_rules! embed {
     ($stem:literal) => {
         $crate::embed::Embedded {
-            path: concat!("models/", $stem, ".yaml"),
+            path: concat!("crates/", env!("CARGO_PKG_NAME"), "/models/", $stem, ".yaml"),
             card: include_str!(concat!(
                 env!("CARGO_MANIFEST_DIR"),
-                "/../../models/",
+                "/models/",
                 $stem,
                 ".yaml"
             )),
@@ -50,7 +52,7 @@ macro_rules! embed {
                 concat!($stem, ".bin"),
                 include_bytes!(concat!(
                     env!("CARGO_MANIFEST_DIR"),
-                    "/../../models/",
+                    "/models/",
                     $stem,
                     ".bin"
                 )),
@@ -60,10 +62,10 @@ macro_rules! embed {
     };
     ($stem:literal, [$($part:literal),+ $(,)?]) => {
         $crate::embed::Embedded {
-            path: concat!("models/", $stem, ".yaml"),
+            path: concat!("crates/", env!("CARGO_PKG_NAME"), "/models/", $stem, ".yaml"),
             card: include_str!(concat!(
                 env!("CARGO_MANIFEST_DIR"),
-                "/../../models/",
+                "/models/",
                 $stem,
                 ".yaml"
             )),
@@ -154,7 +156,6 @@ mod tests {
     use super::*;
 
     const SWAE: Embedded = crate::embed!("swae-v1");
-    const TAL: Embedded = crate::embed!("tal-v1", ["tal-v1.encoder", "tal-v1.gate"]);
 
     #[test]
     fn an_embedded_card_brings_its_checked_weights() {
@@ -176,7 +177,7 @@ mod tests {
         };
         let e = damaged.checked::<ModelCard>().unwrap_err().to_string();
         assert!(
-            e.starts_with("models/swae-v1.yaml: ") && e.contains("digest"),
+            e.starts_with("crates/verti-nn/models/swae-v1.yaml: ") && e.contains("digest"),
             "{e}"
         );
         let e = damaged.network().unwrap_err().to_string();
@@ -196,20 +197,5 @@ mod tests {
             e.contains("weights.file") && e.contains("patch-v1.bin"),
             "{e}"
         );
-    }
-
-    #[test]
-    fn a_composite_card_brings_its_parts() {
-        assert!(TAL.weights.is_none());
-        let gate = TAL.part("tal-v1.gate.yaml").unwrap();
-        assert_eq!(gate.network().unwrap().card().name, "tal-v1.gate");
-        let e = TAL.part("tal-v1.dynamics.yaml").unwrap_err().to_string();
-        assert!(
-            e.starts_with("models/tal-v1.yaml: part tal-v1.dynamics.yaml is not compiled in")
-                && e.contains("tal-v1.encoder, tal-v1.gate"),
-            "{e}"
-        );
-        let e = TAL.network().unwrap_err().to_string();
-        assert!(e.starts_with("models/tal-v1.yaml: "), "{e}");
     }
 }

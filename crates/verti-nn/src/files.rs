@@ -82,8 +82,9 @@ mod tests {
 
     #[test]
     fn a_composite_card_brings_its_parts_and_their_weights() {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
-        let files = card_files(&root.join("tal-v1.yaml")).unwrap();
+        // shipped cards of two families, read as files (as `--param model=...` would)
+        let crates = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let files = card_files(&crates.join("verti-kino/models/tal-v1.yaml")).unwrap();
         let names: Vec<String> = files
             .iter()
             .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
@@ -103,9 +104,9 @@ mod tests {
             );
         }
         // a plain card: itself and its weights
-        let files = card_files(&root.join("acl-v1.yaml")).unwrap();
+        let files = card_files(&crates.join("verti-policy/models/acl-v1.yaml")).unwrap();
         assert_eq!(files.len(), 2, "{files:?}");
-        let e = card_files(&root.join("no-such-card.yaml")).unwrap_err();
+        let e = card_files(&crates.join("verti-policy/models/no-such-card.yaml")).unwrap_err();
         assert!(e.contains("no-such-card.yaml"), "{e}");
     }
 }

@@ -11,7 +11,7 @@
 //! * [`swae`]: the `swae-v1` elevation source (terrain from the trained SWAE decoder);
 //! * [`patch`]: the local-patch terrain encoder used by learned systems;
 //! * [`embed`]: how every crate compiles in the trained models that ship in the repository
-//!   (`models/`), checked against their cards ([`embed!`]), with the one error of model files,
+//!   (each crate's `models/`), checked against their cards ([`embed!`]), with the one error of model files,
 //!   [`ModelError`];
 //! * [`shipped`]: verti-nn's own shipped models (`swae-v1`, `patch-v1`);
 //! * `train` (feature `train`, burn): the network every family trains with (`train::seq`) and the

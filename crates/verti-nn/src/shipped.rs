@@ -1,4 +1,4 @@
-//! verti-nn's trained models that ship in the repository's `models/` directory, compiled in
+//! verti-nn's trained models that ship in this crate's `models/` directory, compiled in
 //! ([`crate::embed!`]).
 
 use crate::embed::Embedded;

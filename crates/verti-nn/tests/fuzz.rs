@@ -71,9 +71,9 @@ fn seeds() -> &'static [Seed] {
         };
         std::fs::remove_dir_all(&dir).ok();
         let shipped = Seed {
-            card: include_str!("../../../models/evora-v1.decoder1.yaml").into(),
+            card: include_str!("../../verti-pietra/models/evora-v1.decoder1.yaml").into(),
             weights_file: "evora-v1.decoder1.bin".into(),
-            weights: include_bytes!("../../../models/evora-v1.decoder1.bin").to_vec(),
+            weights: include_bytes!("../../verti-pietra/models/evora-v1.decoder1.bin").to_vec(),
         };
         vec![tiny, shipped]
     })

@@ -266,7 +266,7 @@ mod tests {
         // past the map's edge
         let model = crate::shipped::pietra_v1().unwrap();
         let models = ["evora-v1", "pi-v1", "vanilla-v1"].map(|name| {
-            let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+            let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
             crate::model::TravModel::load(&dir.join(format!("{name}.yaml"))).unwrap()
         });
         let mut sources = vec![Source::Model(&model), Source::Physics];

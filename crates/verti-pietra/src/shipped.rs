@@ -1,4 +1,4 @@
-//! The traversability model that ships in `models/` (`pietra-v1`), compiled into the binary so
+//! The traversability model that ships in this crate's `models/` (`pietra-v1`), compiled into the binary so
 //! a fresh clone plans with it without training (`verti learn pietra` reproduces it).
 
 use crate::model::TravModel;

@@ -9,7 +9,7 @@
 //!   in both.
 //! * [`Policy`]: the actor network with its Gaussian's spread, read from a model card.
 //! * [`system`]: a policy as a benchmark system, and the registered `rl`, `mcl` and `acl`.
-//! * [`shipped`]: the trained policies that ship in `models/`.
+//! * [`shipped`]: the trained policies that ship in this crate's `models/`.
 
 pub mod inputs;
 pub mod policy;

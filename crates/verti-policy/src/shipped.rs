@@ -1,4 +1,4 @@
-//! The trained policies that ship in `models/`, compiled into the binary so a fresh clone
+//! The trained policies that ship in this crate's `models/`, compiled into the binary so a fresh clone
 //! evaluates `rl`, `mcl` and `acl` without training (`verti learn rl --curriculum ...`
 //! reproduces each; the command is in its card).
 

@@ -40,7 +40,7 @@ fn main() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let card = PathBuf::from(
         args.first()
-            .map_or("models/va-small-v1.yaml", |s| s.as_str()),
+            .map_or("crates/verti-va/models/va-small-v1.yaml", |s| s.as_str()),
     );
     let samples: usize = args
         .get(1)

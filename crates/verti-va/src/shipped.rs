@@ -1,6 +1,6 @@
 //! The model the `va` system plans with by default (`va-small-v1`: 24 basis fields of
 //! [32, 32]), compiled in so a fresh clone plans without training (`verti learn va --hidden
-//! 32,32 --out models/va-small-v1.yaml` reproduces it).
+//! 32,32 --out crates/verti-va/models/va-small-v1.yaml` reproduces it).
 
 use crate::model::{VaCard, VaModel};
 use std::sync::Arc;
