@@ -87,6 +87,13 @@ pub struct BenchArgs {
     /// Runs per case (the median is reported).
     #[arg(long, default_value_t = 3)]
     runs: usize,
+    /// Trace the benchmark's drive on this world instead (`SET:N`, e.g. verti-100:3, or a world
+    /// directory; needs --vehicle): a line of state every --every control steps of 20 ms.
+    #[arg(long, requires = "vehicle", conflicts_with = "json")]
+    trace: Option<String>,
+    /// With --trace: print every N-th control step.
+    #[arg(long, default_value_t = 50, requires = "trace")]
+    every: u64,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -107,6 +114,16 @@ pub struct SoakArgs {
     seed: u64,
     #[arg(long)]
     json: bool,
+    /// Trace one episode instead: the episode seed a failure reports (needs --world and
+    /// --vehicle; the world is generated at the vehicle's scale, as the soak does).
+    #[arg(long, requires_all = ["world", "vehicle"], conflicts_with = "json")]
+    replay: Option<u64>,
+    /// With --replay: the failure's world, `SET:N` (e.g. verti-100:17) or a world directory.
+    #[arg(long, requires = "replay")]
+    world: Option<String>,
+    /// With --replay: print every N-th control step of 10 ms.
+    #[arg(long, default_value_t = 10, requires = "replay")]
+    every: u64,
 }
 
 fn vehicles_arg(v: &Option<String>) -> Result<Vec<VehicleSpec>, Box<dyn std::error::Error>> {
@@ -123,6 +140,20 @@ pub fn run_sim(cmd: SimCommand) -> CmdResult {
                 return Err("--seconds must be positive and --runs at least 1".into());
             }
             let specs = vehicles_arg(&a.vehicle)?;
+            if let Some(world) = &a.trace {
+                let spec = &specs[0];
+                let world = Arc::new(verti_world::sets::resolve_world(
+                    &sim_tools::world_argument(world),
+                    spec.scale,
+                )?);
+                return Ok(sim_tools::bench_trace(
+                    &world,
+                    spec,
+                    a.seconds,
+                    a.every,
+                    |line| println!("{line}"),
+                )?);
+            }
             let worlds = BenchWorlds::generated_for(&specs)?;
             let report = sim_tools::bench(&worlds, &specs, a.seconds, a.runs);
             if a.json {
@@ -134,6 +165,19 @@ pub fn run_sim(cmd: SimCommand) -> CmdResult {
         }
         SimCommand::Compare(a) => crate::compare_cmd::compare(a),
         SimCommand::Soak(a) => {
+            if let (Some(seed), Some(world)) = (a.replay, &a.world) {
+                let spec = vehicles_arg(&a.vehicle)?.remove(0);
+                let world = Arc::new(verti_world::sets::resolve_world(
+                    &sim_tools::world_argument(world),
+                    spec.scale,
+                )?);
+                let episode =
+                    sim_tools::replay(&world, &spec, seed, a.every, |line| println!("{line}"));
+                return match episode.error {
+                    None => Ok(()),
+                    Some((t, e)) => Err(format!("the episode fails at t = {t:.3} s: {e}").into()),
+                };
+            }
             let specs = vehicles_arg(&a.vehicle)?;
             let set = load_set_with_progress(&a.worlds, 1.0)?;
             let mut worlds: Vec<Arc<verti_world::World>> =

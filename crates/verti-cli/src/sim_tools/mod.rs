@@ -5,14 +5,17 @@
 //! Why here and not in `verti-sim`: like rapier's benchmarks, they measure the engine from the
 //! outside, through its public API alone (`Sim`, `SimState`, `VehicleSpec`), so the engine
 //! library carries no benchmark code and no benchmark-only surface. The CLI is their only
-//! caller; `verti-sim`'s `examples/replay.rs` and `examples/trace.rs` mirror the soak episode and
-//! the benchmark driver for debugging, and must change with them.
+//! caller. A soak failure is traced by replaying its episode through the same code
+//! ([`soak::replay`], `verti sim soak --replay SEED`), and the benchmark's drive by
+//! [`bench_trace`] (`verti sim bench --trace WORLD`, also the drive to profile).
 
 mod bench;
 mod soak;
+mod trace;
 
 pub use bench::{BenchWorlds, bench};
-pub use soak::soak;
+pub use soak::{replay, soak, world_argument};
+pub use trace::bench_trace;
 
 #[cfg(test)]
 mod tests {
@@ -52,5 +55,25 @@ mod tests {
             (a.episodes, a.simulated_seconds, a.rollovers, a.max_speed),
             (b.episodes, b.simulated_seconds, b.rollovers, b.max_speed)
         );
+    }
+
+    // `--replay SEED` must trace the very episode the soak ran and reported.
+    #[test]
+    fn a_replay_is_the_soak_episode_of_its_seed() {
+        let spec = vehicles::builtin("verti4").unwrap();
+        let world = Arc::new(testing::rough_world(0.1, 10, 16.0, RoughSurface::Mixed));
+        let ran = soak::soak_episode(&world, &spec, 77, 6000, |_, _, _| {});
+        let mut lines = Vec::new();
+        let traced = replay(&world, &spec, 77, 25, |l| lines.push(l.to_string()));
+        assert_eq!(
+            (traced.steps, traced.simulated_seconds, traced.max_speed),
+            (ran.steps, ran.simulated_seconds, ran.max_speed)
+        );
+        assert_eq!(lines.len() as u64, ran.steps / 25 + 1);
+        assert!(lines[0].starts_with("t   0.25 p ("), "{}", lines[0]);
+        assert!(lines.last().unwrap().contains("error: none"));
+        assert_eq!(world_argument("verti-100/017"), "verti-100:17");
+        assert_eq!(world_argument("verti-100/100"), "verti-100:100");
+        assert_eq!(world_argument("rough-mixed"), "rough-mixed");
     }
 }

@@ -56,6 +56,13 @@ impl fmt::Display for SoakReport {
                 "  FAIL {} on {} episode {} (seed {}), t = {:.3}: {}",
                 fl.vehicle, fl.world, fl.episode, fl.episode_seed, fl.time, fl.error
             )?;
+            writeln!(
+                f,
+                "       trace it: verti sim soak --replay {} --world {} --vehicle {}",
+                fl.episode_seed,
+                world_argument(&fl.world),
+                fl.vehicle
+            )?;
         }
         Ok(())
     }
@@ -229,4 +236,44 @@ pub fn soak(
     report.wall_seconds = t0.elapsed().as_secs_f64();
     progress(done);
     report
+}
+
+/// The `--world` argument that names a soak world: a built-in set's world is reported by its
+/// name, `SET/NNN`, and named on the command line as `SET:N`.
+pub fn world_argument(name: &str) -> String {
+    match name.rsplit_once('/') {
+        Some((set, index)) if index.parse::<u32>().is_ok() => {
+            format!("{set}:{}", index.trim_start_matches('0'))
+        }
+        _ => name.to_string(),
+    }
+}
+
+/// Replays the soak episode of `episode_seed` (the very episode `soak` ran: same draws, same
+/// steps) and hands `print` a trace line every `every` control steps, then a closing line.
+pub fn replay(
+    world: &Arc<World>,
+    spec: &VehicleSpec,
+    episode_seed: u64,
+    every: u64,
+    mut print: impl FnMut(&str),
+) -> SoakEpisode {
+    let mut k = 0u64;
+    // 6000 steps of 10 ms: the soak's longest episode (60 s)
+    let episode = soak_episode(world, spec, episode_seed, 6000, |_, state, controls| {
+        k += 1;
+        if k.is_multiple_of(every.max(1)) {
+            print(&super::trace::trace_line(state, controls));
+        }
+    });
+    print(&format!(
+        "{} steps, {:.2} simulated s, error: {}",
+        episode.steps,
+        episode.simulated_seconds,
+        episode
+            .error
+            .as_ref()
+            .map_or("none".to_string(), |(t, e)| format!("at t = {t:.3} s: {e}"))
+    ));
+    episode
 }
