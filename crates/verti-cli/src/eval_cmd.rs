@@ -80,7 +80,7 @@ pub struct EvalArgs {
     #[arg(long, value_parser = ["last10", "all"])]
     log_steps: Option<String>,
     /// Perception noise on what the system observes (never on the physics): none (default),
-    /// low, medium, high, or a YAML file (see README "Perception noise").
+    /// low, medium, high, or a YAML file (see the guide docs/src/guides/perception.md).
     #[arg(long, default_value = "none")]
     perception: String,
     /// Run only shard i of N (0 <= i < N) of the selected tasks, for cluster array jobs;
