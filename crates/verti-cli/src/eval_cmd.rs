@@ -53,7 +53,7 @@ pub struct EvalArgs {
     /// Parallel trials (default: all cores). Results do not depend on it.
     #[arg(long)]
     jobs: Option<usize>,
-    /// Output directory (default: results/<system>-<set>).
+    /// Output directory (default: results/SYSTEM-SET).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Continue an interrupted run in --out, skipping finished tasks.

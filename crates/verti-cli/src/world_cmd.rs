@@ -83,7 +83,7 @@ pub struct GenerateArgs {
     /// Elevation source parameter, name=value (repeatable).
     #[arg(long = "elevation-param", value_parser = crate::cli_common::assignment)]
     elevation_params: Vec<String>,
-    /// Output directory (default: worlds/<set name>); its parent must exist.
+    /// Output directory (default: worlds/SET_NAME); its parent must exist.
     #[arg(long, value_parser = crate::outputs::out_dir)]
     out: Option<PathBuf>,
     /// Overwrite an existing non-empty output directory.

@@ -3,7 +3,7 @@
 //! Fidelity of verti against reference runs of another engine, such as the Chrono runs in
 //! `../shared/chrono-reference`: the same tasks are re-run in verti and compared.
 //!
-//! * [`reference`]: reading the reference's `outcomes.jsonl` and 10 Hz trajectory files.
+//! * [`reference`](mod@reference): reading the reference's `outcomes.jsonl` and 10 Hz trajectory files.
 //! * [`select`]: which reference tasks to compare (`--tasks`).
 //! * [`run`]: the verti side, set up as the reference describes ([`CompareSetup`]: world with
 //!   one rigid surface everywhere, PID with the reference's steering law), run in parallel and

@@ -4,7 +4,7 @@
 //!
 //! * **random** exploration: sinusoidal steering at a constant 2 m/s (the paper's profile) or
 //!   VertiAdaptor's sinusoidal steering and speed, from random starts until rollover, stuck,
-//!   the map's edge or a length cap ([`generate`]);
+//!   the map's edge or a length cap ([`generate`](mod@generate));
 //! * **failures**: the last 10 s before each rollover or stuck, classified by the paper's rule
 //!   ([`classify`]), harvested from random exploration or from a system's evaluation runs;
 //! * **expert** demonstrations: the successful trials of a system on a set's tasks.

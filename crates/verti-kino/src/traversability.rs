@@ -3,7 +3,8 @@
 //! cell, how hard the next second will be: the largest roll or pitch it reaches and how far it
 //! falls short of its commanded speed. Trained self-supervised from exploration datasets
 //! (`verti learn kino --model tnt`); applied once per plan to a map around the vehicle; its
-//! value at every rollout pose is a cost ([`TraversabilityCost`]).
+//! value at every rollout pose is a cost
+//! ([`AttitudeCost::with_traversability`](crate::rollout::AttitudeCost::with_traversability)).
 //!
 //! Input: two channels of slopes, along the heading and to the left (dimensionless rise over
 //! run, full-scale), on a square lattice of `SPACING`; slopes ignore the absolute height, so

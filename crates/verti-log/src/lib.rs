@@ -3,10 +3,10 @@
 //! Parquet dependency is large and most of verti does not need it.
 //!
 //! Columns: `task` (INT32), then one DOUBLE column per feature of
-//! [`verti_bench::features::STEP_LOG`], named as the feature schema names them: `t` [s], `x`,
-//! `y`, `z` [m, chassis reference point, world frame], `roll`, `pitch`, `yaw` [rad], `vx`, `vy`,
-//! `vz` [m/s, body frame], `wx`, `wy`, `wz` [rad/s, body frame], `throttle`, `brake`,
-//! `steering` [driver inputs].
+//! [`verti_bench::features::STEP_LOG`], named as the feature schema names them: `t` \[s\], `x`,
+//! `y`, `z` \[m, chassis reference point, world frame\], `roll`, `pitch`, `yaw` \[rad\], `vx`, `vy`,
+//! `vz` \[m/s, body frame\], `wx`, `wy`, `wz` \[rad/s, body frame\], `throttle`, `brake`,
+//! `steering` \[driver inputs\].
 //! File metadata (key/value): `verti.task`, `verti.world`, `verti.system`, `verti.vehicle`,
 //! `verti.outcome`.
 

@@ -10,7 +10,7 @@
 //! * [`Mlp`]: the allocation-free MLP path for networks called inside planners;
 //! * [`swae`]: the `swae-v1` elevation source (terrain from the trained SWAE decoder);
 //! * [`patch`]: the local-patch terrain encoder used by learned systems;
-//! * [`embed`]: how every crate compiles in the trained models that ship in the repository
+//! * [`embed`](mod@embed): how every crate compiles in the trained models that ship in the repository
 //!   (each crate's `models/`), checked against their cards ([`embed!`]), with the one error of model files,
 //!   [`ModelError`];
 //! * [`shipped`]: verti-nn's own shipped models (`swae-v1`, `patch-v1`);

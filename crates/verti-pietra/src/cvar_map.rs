@@ -20,9 +20,9 @@ use verti_world::Heightfield;
 pub struct CvarMap {
     pub region: Region,
     pub alpha: f64,
-    /// [param][yaw][row][col]: CVaR← of ψ1, ψ2 (traction, [0, 1]) and CVaR→ of ψ3, ψ4 (rad).
+    /// \[param\]\[yaw\]\[row\]\[col\]: CVaR← of ψ1, ψ2 (traction, [0, 1]) and CVaR→ of ψ3, ψ4 (rad).
     pub values: Vec<f32>,
-    /// [yaw][row][col]: latent density below the model's lowest training density.
+    /// \[yaw\]\[row\]\[col\]: latent density below the model's lowest training density.
     pub ood: Vec<bool>,
 }
 

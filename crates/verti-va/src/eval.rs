@@ -192,7 +192,7 @@ pub fn errors(
 
 /// Errors of `model` adapting online while it drives `trajectories` (one world's, in order):
 /// before each step the model predicts with its current coefficients (one step, and a
-/// rollout every `stride` steps), then the [`Adapter`] takes in the step, as the `va` system
+/// rollout every `stride` steps), then the [`Adapter`](crate::adapter::Adapter) takes in the step, as the `va` system
 /// does. The adapter carries over from one trajectory to the next (the same world), but no
 /// example spans two. `mode` `once`/`none` keep the coefficients they start with, `alpha0`.
 pub fn online_errors(

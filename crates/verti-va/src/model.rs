@@ -18,8 +18,8 @@
 //! absolute; verti follows the algorithm.
 //!
 //! Weights live in one little-endian f32 file: each embedding network's layers (weights
-//! [inputs][outputs], then biases), then the fields' layers stacked over the k fields
-//! (weights [k][inputs][outputs], then biases [k][outputs]).
+//! \[inputs\]\[outputs\], then biases), then the fields' layers stacked over the k fields
+//! (weights \[k\]\[inputs\]\[outputs\], then biases \[k\]\[outputs\]).
 
 // the network's dimensions live in `dims` (the field kernel needs them too); `model::` stays
 // their public path

@@ -4,6 +4,22 @@
 //! (elevation [`Heightfield`], semantic [`PatchGrid`], [`Obstacle`]s, [`Task`]s and their
 //! [`GlobalPath`]s), the procedural generator of the 100-world / 1000-task benchmark set, the
 //! versioned on-disk format, and the importer for original Verti-Bench worlds.
+//!
+//! # Example
+//!
+//! One world of the built-in evaluation set, generated on the spot (bit-identical on every
+//! machine), with its ten start/goal tasks and the ground under a point:
+//!
+//! ```
+//! let world = verti_world::sets::resolve_world("verti-100:42", 1.0).unwrap();
+//! assert_eq!(world.tasks.len(), 10);
+//! let task = &world.tasks[0];
+//! let z = world.terrain.height_at(task.start[0], task.start[1]);
+//! println!(
+//!     "{} ({:?}, {:?}, {:?}): first start at {:?}, {z:.2} m up",
+//!     world.meta.name, world.meta.level, world.meta.terrain_type, world.meta.density, task.start
+//! );
+//! ```
 
 pub mod checks;
 pub mod error;

@@ -127,11 +127,11 @@ pub struct SoilParams {
     pub bekker_kc: f64,
     /// Bekker sinkage exponent n [-].
     pub bekker_n: f64,
-    /// Mohr cohesion c [Pa].
+    /// Mohr cohesion c \[Pa\].
     pub cohesion: f64,
-    /// Mohr internal friction angle φ [deg].
+    /// Mohr internal friction angle φ \[deg\].
     pub friction_angle_deg: f64,
-    /// Janosi shear modulus K [m].
+    /// Janosi shear modulus K \[m\].
     pub janosi_k: f64,
     /// Elastic stiffness for unloading/reloading [Pa/m].
     pub elastic_k: f64,

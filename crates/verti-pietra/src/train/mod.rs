@@ -1,6 +1,6 @@
 //! PIETRA and its baselines on burn: the losses ([`special`]), the networks ([`model`]), the
 //! benchmark's data ([`data`]), one training run ([`fit`]) and the learning benchmark of the
-//! paper's Tables I–II and Fig. 6 ([`bench`]). The plain-Rust half (bins, physics prior, maps,
+//! paper's Tables I–II and Fig. 6 ([`bench`](mod@bench)). The plain-Rust half (bins, physics prior, maps,
 //! dataset, CVaR) is `verti-pietra`.
 
 pub mod bench;

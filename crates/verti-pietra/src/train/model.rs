@@ -153,7 +153,7 @@ impl RadialFlow {
         (z, log_det)
     }
 
-    /// log p(z) of latents z [N, H] under the flow with a standard normal base → [N].
+    /// log p(z) of latents z [N, H] under the flow with a standard normal base → \[N\].
     pub fn log_prob(&self, z: Tensor<2>) -> Tensor<1> {
         let [n, h] = z.dims();
         let (z, log_det) = self.forward(z);
@@ -179,7 +179,7 @@ pub fn init_params(layers: &[LayerSpec], rng: &mut Rng) -> Vec<f32> {
 
 /// What the network says about a batch.
 pub struct Prediction {
-    /// log p(z) under the flow [N] (evidential methods).
+    /// log p(z) under the flow \[N\] (evidential methods).
     pub log_density: Tensor<1>,
     /// p_φ: one PMF per (sample, parameter), rows [N·4, B].
     pub pmf: Tensor<2>,

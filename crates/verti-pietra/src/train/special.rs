@@ -17,7 +17,7 @@ pub fn cumsum_matrix(device: &Device) -> Tensor<2> {
     Tensor::from_data(TensorData::new(u, [B, B]), device)
 }
 
-/// EMD²(p, y) = Σ_i (cs(p)_i − cs(y)_i)² per row of `p`, `y` [N, B] → [N].
+/// EMD²(p, y) = Σ_i (cs(p)_i − cs(y)_i)² per row of `p`, `y` [N, B] → \[N\].
 pub fn emd2(p: Tensor<2>, y: Tensor<2>, cs: &Tensor<2>) -> Tensor<1> {
     let [n, _] = p.dims();
     (p - y)
@@ -74,7 +74,7 @@ pub fn digamma(x: Tensor<2>) -> Tensor<2> {
 /// terms of 10⁵ and more, past what f32 resolves.
 pub const ENTROPY_APPROX_BETA0: f64 = 1e4;
 
-/// Entropy of Dir(β) per row of β [N, K] → [N]:
+/// Entropy of Dir(β) per row of β [N, K] → \[N\]:
 /// Σ lnΓ(β_b) − lnΓ(β0) + (β0 − K) ψ(β0) − Σ (β_b − 1) ψ(β_b); for β0 ≥ 10⁴ the asymptotic
 /// ½(K−1)(1 + ln 2π) + ½ Σ ln β_b − (K − ½) ln β0.
 pub fn dirichlet_entropy(beta: Tensor<2>) -> Tensor<1> {

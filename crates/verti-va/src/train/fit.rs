@@ -191,7 +191,7 @@ fn query_coefficients(
 }
 
 /// The method's loss on one draw (for `maml`, the query loss without adaptation; its
-/// training step is [`maml_step`]).
+/// training step is `maml_step`).
 pub fn draw_loss(net: &VaNet, d: &Draw, lambda: f64, device: &Device) -> Result<Tensor<1>, String> {
     match net.spec.method {
         Method::Va | Method::Node => {
