@@ -46,7 +46,7 @@ def main():
         action = env.action_space.sample()
         action[0] = 0.5 + 0.5 * action[0]  # mostly forward, so the random walk goes somewhere
         obs, reward, terminated, truncated, info = env.step(action)
-        total += reward
+        total += float(reward)  # gymnasium types the reward as SupportsFloat
         steps += 1
         if terminated or truncated:
             break

@@ -47,7 +47,7 @@ they exit when the parent dies, even when it is killed with SIGKILL.
 from __future__ import annotations
 
 import os
-from typing import Any, Callable, Dict, Optional, Sequence, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import gymnasium as gym
 import numpy as np
@@ -55,7 +55,7 @@ from gymnasium import spaces
 from gymnasium.vector import VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from ._verti import OUTCOMES, EnvCore, VecEnvCore, World, load_worlds
+from ._verti import OUTCOMES, EnvCore, Sim, VecEnvCore, World, load_worlds
 
 ENV_ID = "verti/Navigate-v0"
 
@@ -76,16 +76,18 @@ DEFAULT_REWARD: Dict[str, float] = {
 }
 
 WorldsArg = Union[str, World, Sequence[World]]
+#: A heading-aligned map patch: None (off), a size in cells of 0.1 m, or (size, resolution_m).
+CropArg = Union[None, int, Tuple[int, float]]
 RewardArg = Union[None, Dict[str, float], Callable[[Dict[str, np.ndarray], np.ndarray, Dict[str, Any]], float]]
 
 
 # Worlds by built-in name, shared by every environment of this process: worlds are immutable,
 # and generating verti-100 takes about two seconds, which gym.make_vec(..., "sync") would
 # otherwise pay once per environment. Directories are not cached (their files may change).
-_WORLD_CACHE: Dict[Any, Any] = {}
+_WORLD_CACHE: Dict[Tuple[str, Optional[float]], List[World]] = {}
 
 
-def _resolve_worlds(world: WorldsArg, scale: Optional[float]):
+def _resolve_worlds(world: WorldsArg, scale: Optional[float]) -> WorldsArg:
     if not isinstance(world, str):
         return world
     base, _, index = world.rpartition(":")
@@ -112,23 +114,23 @@ def _count_arg(name: str, value: Any) -> int:
 
 def _settings(
     *,
-    tasks,
-    levels,
-    densities,
-    terrain_types,
-    scale,
-    control_rate,
-    action_mode,
-    max_speed,
-    max_time,
-    rules,
-    lookahead,
-    elevation,
-    semantic,
-    occupancy,
-    reward,
-    state_features=None,
-    perception=None,
+    tasks: Union[None, str, int, Sequence[int]],
+    levels: Union[None, str, Sequence[str]],
+    densities: Union[None, str, Sequence[str]],
+    terrain_types: Union[None, str, Sequence[str]],
+    scale: Optional[float],
+    control_rate: float,
+    action_mode: str,
+    max_speed: float,
+    max_time: float,
+    rules: str,
+    lookahead: float,
+    elevation: CropArg,
+    semantic: CropArg,
+    occupancy: CropArg,
+    reward: RewardArg,
+    state_features: Optional[Sequence[str]] = None,
+    perception: Optional[str] = None,
 ) -> Dict[str, Any]:
     weights = reward if isinstance(reward, dict) else None
     if reward is not None and weights is None and not callable(reward):
@@ -155,7 +157,7 @@ def _settings(
 
 
 def _observation_space(layout: Dict[str, Any]) -> spaces.Dict:
-    parts = {}
+    parts: Dict[str, spaces.Space[Any]] = {}
     for name, (shape, dtype) in layout.items():
         if dtype == "float32":
             parts[name] = spaces.Box(-np.inf, np.inf, shape=tuple(shape), dtype=np.float32)
@@ -224,9 +226,9 @@ class NavigateEnv(gym.Env):
         max_time: float = 60.0,
         rules: str = "paper",
         lookahead: float = 10.0,
-        elevation=None,
-        semantic=None,
-        occupancy=None,
+        elevation: CropArg = None,
+        semantic: CropArg = None,
+        occupancy: CropArg = None,
         reward: RewardArg = None,
         state_features: Optional[Sequence[str]] = None,
         perception: Optional[str] = None,
@@ -266,7 +268,9 @@ class NavigateEnv(gym.Env):
         self.action_space = _action_space(self._core.action_mode)
         self.metadata = dict(self.metadata, render_fps=int(round(self._core.control_rate)))
 
-    def reset(self, *, seed: Optional[int] = None, options: Optional[Dict[str, Any]] = None):
+    def reset(
+        self, *, seed: Optional[int] = None, options: Optional[Dict[str, Any]] = None
+    ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]:
         super().reset(seed=seed)
         options = options or {}
         unknown = set(options) - {"task"}
@@ -298,17 +302,17 @@ class NavigateEnv(gym.Env):
             return None
         return self._core.render(self._pixels_per_cell)
 
-    def sim(self):
+    def sim(self) -> Sim:
         """A ``verti.Sim`` at the current state (a copy: stepping it leaves the episode alone)."""
         return self._core.sim()
 
     @property
-    def task_numbers(self):
+    def task_numbers(self) -> List[int]:
         """Global task numbers the sampler draws from."""
         return self._core.task_numbers
 
     @property
-    def worlds(self):
+    def worlds(self) -> List[World]:
         return self._core.worlds
 
 
@@ -344,9 +348,9 @@ class NavigateVectorEnv(VectorEnv):
         max_time: float = 60.0,
         rules: str = "paper",
         lookahead: float = 10.0,
-        elevation=None,
-        semantic=None,
-        occupancy=None,
+        elevation: CropArg = None,
+        semantic: CropArg = None,
+        occupancy: CropArg = None,
         reward: RewardArg = None,
         state_features: Optional[Sequence[str]] = None,
         perception: Optional[str] = None,
@@ -387,9 +391,12 @@ class NavigateVectorEnv(VectorEnv):
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.metadata = dict(self.metadata, render_fps=int(round(self._core.control_rate)))
 
-    def reset(self, *, seed: Union[None, int, Sequence[int]] = None, options: Optional[Dict[str, Any]] = None):
+    def reset(
+        self, *, seed: Union[None, int, Sequence[int]] = None, options: Optional[Dict[str, Any]] = None
+    ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]:
         if options:
             raise ValueError(f"unknown reset options {sorted(options)}; the vector environment takes none")
+        core_seed: Union[None, int, Sequence[int]]
         if isinstance(seed, (int, np.integer)):
             self._np_random, self._np_random_seed = gym.utils.seeding.np_random(int(seed))
             core_seed = int(seed)

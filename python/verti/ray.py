@@ -23,7 +23,7 @@ import json
 import os
 import signal
 import tempfile
-from typing import Any, Callable, Dict, List, Optional, Sequence, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Set, Union
 
 import verti
 
@@ -39,7 +39,7 @@ def _parse_tasks(spec: TasksArg) -> List[int]:
     if isinstance(spec, str):
         if spec.strip() == "all":
             return []
-        out = set()
+        out: Set[int] = set()
         for part in spec.split(","):
             a, _, b = part.strip().partition("-")
             lo, hi = int(a), int(b or a)
@@ -147,7 +147,7 @@ def evaluate(
         raise TypeError("verti.ray.evaluate runs built-in systems by name (Python objects do not travel)")
     if chunk < 1:
         raise ValueError("chunk must be at least 1")
-    settings = dict(
+    settings: Dict[str, Any] = dict(
         vehicle=vehicle,
         params=params,
         rules=rules,

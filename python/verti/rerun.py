@@ -15,12 +15,12 @@ from __future__ import annotations
 import json
 import math
 import sys
-from typing import Any, Dict
+from typing import Any, Dict, List, Tuple
 
 import numpy as np
 
 
-def _terrain(rec: Dict[str, Any]):
+def _terrain(rec: Dict[str, Any]) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     n, cell = rec["n"], rec["cell"]
     half = 0.5 * (n - 1) * cell
     cols, rows = np.meshgrid(np.arange(n), np.arange(n))
@@ -32,8 +32,10 @@ def _terrain(rec: Dict[str, Any]):
     return pos.astype(np.float32), tri.astype(np.uint32), colors
 
 
-def _prisms(rec: Dict[str, Any]):
-    pos, tri, col = [], [], []
+def _prisms(rec: Dict[str, Any]) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    pos: List[Tuple[float, float, float]] = []
+    tri: List[Tuple[int, int, int]] = []
+    col: List[Tuple[int, int, int]] = []
     for o in rec["obstacles"]:
         p, m = o["polygon"], len(o["polygon"])
         base = len(pos)

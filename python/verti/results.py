@@ -7,7 +7,10 @@ into columns that pandas (optional) or any table tool takes directly.
 
 from __future__ import annotations
 
-from typing import Any, Dict, Iterable, List
+from typing import TYPE_CHECKING, Any, Dict, Iterable, List
+
+if TYPE_CHECKING:
+    import pandas
 
 
 def flatten_result(result: Dict[str, Any], prefix: str = "") -> Dict[str, Any]:
@@ -36,7 +39,7 @@ def results_table(results: Iterable[Dict[str, Any]]) -> Dict[str, List[Any]]:
     return {c: [row.get(c) for row in rows] for c in columns}
 
 
-def to_dataframe(results: Iterable[Dict[str, Any]]):
+def to_dataframe(results: Iterable[Dict[str, Any]]) -> pandas.DataFrame:
     """Trials as a pandas DataFrame (needs pandas: ``pip install pandas``)."""
     try:
         import pandas as pd
