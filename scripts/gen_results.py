@@ -13,11 +13,19 @@ A block in a page under docs/src/ reads
 
 and is replaced by that section of `verti report` over the listed runs (a folder and the
 system names in it), so a figure on those pages always comes from a committed file and one
-command. VERTI defaults to target/release/verti.
+command. A block
+
+    <!-- command: python3 scripts/robustness_table.py ; table: 2 -->
+    ...
+    <!-- end command -->
+
+is replaced by the N-th table (blank-line separated) that a script of scripts/ prints when run
+from the repository root. VERTI defaults to target/release/verti.
 """
 
 import pathlib
 import re
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -29,6 +37,22 @@ BLOCK = re.compile(
     r"(<!-- end report -->)",
     re.S,
 )
+COMMAND = re.compile(
+    r"(<!-- command: (?P<command>[^;]+?) ; table: (?P<table>\d+) -->\n)"
+    r"(?P<body>.*?)"
+    r"(<!-- end command -->)",
+    re.S,
+)
+
+
+def command_output(command, cache, where):
+    args = shlex.split(command)
+    if len(args) < 2 or args[0] != "python3" or not args[1].startswith("scripts/"):
+        sys.exit(f"{where}: a command block runs `python3 scripts/...` only, not `{command}`")
+    if command not in cache:
+        done = subprocess.run(args, cwd=ROOT, check=True, capture_output=True, text=True)
+        cache[command] = [t.strip() + "\n" for t in done.stdout.split("\n\n") if t.strip()]
+    return cache[command]
 
 
 def report(verti, folder, systems, cache, tmp):
@@ -60,7 +84,7 @@ def main():
     args = [a for a in sys.argv[1:] if a != "--check"]
     verti = args[0] if args else str(ROOT / "target/release/verti")
     check = "--check" in sys.argv
-    cache, stale, blocks = {}, [], 0
+    cache, commands, stale, blocks = {}, {}, [], 0
     with tempfile.TemporaryDirectory() as tmp:
         for page in sorted((ROOT / "docs/src").rglob("*.md")):
             text = page.read_text(encoding="utf-8")
@@ -73,7 +97,17 @@ def main():
                 body = "\n" + section(md, m["section"].strip(), where) + "\n"
                 return m.group(1) + body + m.group(6)
 
-            new = BLOCK.sub(fill, text)
+            def fill_command(m, page=page):
+                nonlocal blocks
+                blocks += 1
+                where = page.relative_to(ROOT)
+                tables = command_output(m["command"].strip(), commands, where)
+                n = int(m["table"])
+                if not 1 <= n <= len(tables):
+                    sys.exit(f"{where}: `{m['command']}` prints {len(tables)} tables, not {n}")
+                return m.group(1) + "\n" + tables[n - 1] + "\n" + m.group(5)
+
+            new = COMMAND.sub(fill_command, BLOCK.sub(fill, text))
             if new != text:
                 stale.append(str(page.relative_to(ROOT)))
                 if not check:

@@ -1,4 +1,4 @@
-"""The README's robustness tables: success (%) per system at each perception preset.
+"""The robustness tables of the documentation (docs/src/results/robustness.md): success (%) per system at each perception preset.
 
     bash scripts/benchmarks.sh unpack && python3 scripts/robustness_table.py
 
