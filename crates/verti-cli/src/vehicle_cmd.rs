@@ -142,10 +142,7 @@ pub fn run_sim(cmd: SimCommand) -> CmdResult {
             let specs = vehicles_arg(&a.vehicle)?;
             if let Some(world) = &a.trace {
                 let spec = &specs[0];
-                let world = Arc::new(verti_world::sets::resolve_world(
-                    &sim_tools::world_argument(world),
-                    spec.scale,
-                )?);
+                let world = sim_tools::traced_world(world, spec.scale)?;
                 return Ok(sim_tools::bench_trace(
                     &world,
                     spec,
@@ -167,10 +164,7 @@ pub fn run_sim(cmd: SimCommand) -> CmdResult {
         SimCommand::Soak(a) => {
             if let (Some(seed), Some(world)) = (a.replay, &a.world) {
                 let spec = vehicles_arg(&a.vehicle)?.remove(0);
-                let world = Arc::new(verti_world::sets::resolve_world(
-                    &sim_tools::world_argument(world),
-                    spec.scale,
-                )?);
+                let world = sim_tools::traced_world(world, spec.scale)?;
                 let episode =
                     sim_tools::replay(&world, &spec, seed, a.every, |line| println!("{line}"));
                 return match episode.error {

@@ -14,8 +14,8 @@ mod soak;
 mod trace;
 
 pub use bench::{BenchWorlds, bench};
-pub use soak::{replay, soak, world_argument};
-pub use trace::bench_trace;
+pub use soak::{replay, soak};
+pub use trace::{bench_trace, traced_world};
 
 #[cfg(test)]
 mod tests {
@@ -72,8 +72,8 @@ mod tests {
         assert_eq!(lines.len() as u64, ran.steps / 25 + 1);
         assert!(lines[0].starts_with("t   0.25 p ("), "{}", lines[0]);
         assert!(lines.last().unwrap().contains("error: none"));
-        assert_eq!(world_argument("verti-100/017"), "verti-100:17");
-        assert_eq!(world_argument("verti-100/100"), "verti-100:100");
-        assert_eq!(world_argument("rough-mixed"), "rough-mixed");
+        assert_eq!(trace::world_argument("verti-100/017"), "verti-100:17");
+        assert_eq!(trace::world_argument("verti-100/100"), "verti-100:100");
+        assert_eq!(trace::world_argument("rough-mixed"), "rough-mixed");
     }
 }

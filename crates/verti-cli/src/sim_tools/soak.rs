@@ -60,7 +60,7 @@ impl fmt::Display for SoakReport {
                 f,
                 "       trace it: verti sim soak --replay {} --world {} --vehicle {}",
                 fl.episode_seed,
-                world_argument(&fl.world),
+                super::trace::world_argument(&fl.world),
                 fl.vehicle
             )?;
         }
@@ -236,17 +236,6 @@ pub fn soak(
     report.wall_seconds = t0.elapsed().as_secs_f64();
     progress(done);
     report
-}
-
-/// The `--world` argument that names a soak world: a built-in set's world is reported by its
-/// name, `SET/NNN`, and named on the command line as `SET:N`.
-pub fn world_argument(name: &str) -> String {
-    match name.rsplit_once('/') {
-        Some((set, index)) if index.parse::<u32>().is_ok() => {
-            format!("{set}:{}", index.trim_start_matches('0'))
-        }
-        _ => name.to_string(),
-    }
 }
 
 /// Replays the soak episode of `episode_seed` (the very episode `soak` ran: same draws, same

@@ -6,6 +6,26 @@ use std::sync::Arc;
 use verti_sim::{Controls, Sim, SimError, SimState, StartPose, VehicleSpec};
 use verti_world::World;
 
+/// The `--world` argument that names a soak world: a built-in set's world is reported by its
+/// name, `SET/NNN`, and named on the command line as `SET:N`.
+pub fn world_argument(name: &str) -> String {
+    match name.rsplit_once('/') {
+        Some((set, index)) if index.parse::<u32>().is_ok() => {
+            format!("{set}:{}", index.trim_start_matches('0'))
+        }
+        _ => name.to_string(),
+    }
+}
+
+/// The world a trace drives: `arg` as `--world`/`--trace` take it (`SET:N`, a report's
+/// `SET/NNN`, or a world directory), generated at `scale`, the vehicle's.
+pub fn traced_world(arg: &str, scale: f64) -> Result<Arc<World>, verti_world::error::WorldError> {
+    Ok(Arc::new(verti_world::sets::resolve_world(
+        &world_argument(arg),
+        scale,
+    )?))
+}
+
 /// One line of a trace: time, centre of mass, roll/pitch/yaw in degrees, speed, the controls,
 /// the contact counts (chassis-terrain, chassis-obstacle, wheel-obstacle, soil nodes) and each
 /// wheel's normal force / spring compression / spin rate.
