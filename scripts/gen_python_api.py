@@ -11,6 +11,8 @@ import ast
 import pathlib
 import sys
 
+from generated_page import write_below_marker
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PACKAGE = ROOT / "python/verti"
 PAGE = ROOT / "docs/src/reference/python-api.md"
@@ -48,9 +50,8 @@ def describe_function(fn, owner=None):
     decorators = {ast.unparse(d) for d in fn.decorator_list}
     if "overload" in decorators or "typing.overload" in decorators:
         return ""
-    kind = "property" if "property" in decorators else ("method" if owner else "function")
     name = f"{owner}.{fn.name}" if owner else fn.name
-    if kind == "property":
+    if "property" in decorators:
         returns = f": {ast.unparse(fn.returns)}" if fn.returns else ""
         head = f"`{name}` (property{returns})"
     else:
@@ -99,21 +100,9 @@ def describe_module(path):
 
 
 def main():
-    page = PAGE.read_text(encoding="utf-8")
-    if MARKER not in page:
-        sys.exit(f"{PAGE}: the marker line is missing:\n{MARKER}")
     body = "\n".join(describe_module(PACKAGE / m) for m in MODULES)
-    new = page.split(MARKER)[0] + MARKER + "\n\n" + body.rstrip() + "\n"
-    if "--check" in sys.argv:
-        if new != page:
-            sys.exit(
-                f"{PAGE} is not what the package's sources say: "
-                "run python3 scripts/gen_python_api.py"
-            )
-        print(f"{PAGE.name}: up to date")
-    else:
-        PAGE.write_text(new, encoding="utf-8")
-        print(f"wrote {PAGE} ({len(MODULES)} modules)")
+    write_below_marker(PAGE, MARKER, body.rstrip() + "\n", "--check" in sys.argv,
+                       "python3 scripts/gen_python_api.py")
 
 
 if __name__ == "__main__":
