@@ -13,9 +13,10 @@ use crate::state::{Controls, SimState};
 
 // ---- steering ----
 
-/// Moves the steering toward the driver's input: the bicycle-model angle at the steering's
-/// slew rate (Ackermann), or the input itself (skid steering). Returns the turn radius of the
-/// rear-axle centre (infinite when straight or skid-steered).
+/// Moves the steering toward the driver's input at the steering's slew rate: the bicycle-model
+/// angle, for Ackermann steering the road wheels' centre angle and for skid steering the
+/// equivalent bicycle's (see [`skid_speed_ratio`]). Returns the turn radius of the rear-axle
+/// centre (infinite when straight or skid-steered: no road wheel turns).
 #[inline]
 pub(crate) fn steer(
     spec: &VehicleSpec,
@@ -24,14 +25,23 @@ pub(crate) fn steer(
     ctl: &Controls,
     h: f64,
 ) -> f64 {
-    if spec.steering.kind == SteeringKind::Skid {
-        st.steer = ctl.steering;
-    } else {
-        let target = ctl.steering * spec.steering.max_angle_deg.to_radians();
-        let max_delta = spec.steering.rate_deg_per_s.to_radians() * h;
-        st.steer += (target - st.steer).clamp(-max_delta, max_delta);
-    }
+    let target = ctl.steering * spec.steering.max_angle_deg.to_radians();
+    let max_delta = spec.steering.rate_deg_per_s.to_radians() * h;
+    st.steer += (target - st.steer).clamp(-max_delta, max_delta);
     turn_radius(spec, model, st.steer)
+}
+
+/// Skid steering's speed ratio ρ = inner / outer track speed for the equivalent bicycle angle
+/// `steer`. Every system plans with a bicycle (wheelbase L = [`VehicleSpec::wheelbase`], steer
+/// angle up to `max_angle_deg`); the steer unit realises that bicycle's path curvature
+/// κ = tan(steer) / L kinematically: the vehicle centre moves at v = (v_o + v_i) / 2 and turns
+/// at (v_o − v_i) / B for track speeds v_o, v_i and track gauge B, so κ = 2 (1 − ρ) / (B (1 + ρ))
+/// and ρ = (1 − κ B/2) / (1 + κ B/2) (ρ < 0 counter-rotates the inner track when κ B/2 > 1).
+#[inline]
+pub fn skid_speed_ratio(spec: &VehicleSpec, steer: f64) -> f64 {
+    let half_gauge = 0.5 * spec.axles.first().map_or(0.0, |a| a.track);
+    let kb = libm::tan(steer.abs()) / spec.wheelbase() * half_gauge;
+    (1.0 - kb) / (1.0 + kb)
 }
 
 /// Turn radius of the rear-axle centre for a bicycle steer angle (infinite when straight or
@@ -175,7 +185,8 @@ impl SpinLoads {
 /// Implicit spin: (I/h + K)·ω_new = I·ω/h + T, with K the tyres' linearised longitudinal
 /// stiffness against the spin, then Coulomb brakes solved exactly. Explicitly, a heavily
 /// loaded tyre (impacts) overshoots the no-slip speed within one step and pumps energy into
-/// the vehicle. Skid steering biases the drive toward the outer side and brakes the inner one.
+/// the vehicle. Skid-steered vehicles then hold their two sides at the steer unit's speed
+/// ratio ([`hold_speed_ratio`]).
 #[inline]
 pub(crate) fn solve_spins(
     spec: &VehicleSpec,
@@ -186,24 +197,19 @@ pub(crate) fn solve_spins(
     loads: &SpinLoads,
     h: f64,
 ) -> [f64; MAX_WHEELS] {
-    let skid = spec.steering.kind == SteeringKind::Skid;
     let brake_in = ctl.brake;
     let mut group_reaction = [0.0; MAX_WHEELS];
+    // what the steer unit needs of each side: the implicit equation's right-hand side (after
+    // the brakes) and its factor, and whether the brakes hold the side still
+    let mut rhs = [0.0; MAX_WHEELS];
+    let mut factor = [0.0; MAX_WHEELS];
+    let mut held = [false; MAX_WHEELS];
     for (g, grp) in model.groups.iter().enumerate() {
-        let mut share = grp.drive_share;
         let mut brake_max = 0.0;
         for &w in &grp.wheels {
             brake_max += model.wheels[w].brake_torque * brake_in;
         }
-        if skid {
-            // positive steering turns left: more torque right, brake the left (inner) side
-            share *= 1.0 - grp.side * st.steer;
-            if grp.side * st.steer > 0.0 {
-                brake_max +=
-                    spec.steering.skid_brake_torque * st.steer.abs() * grp.wheels.len() as f64;
-            }
-        }
-        let drive = wheel_torque * share;
+        let drive = wheel_torque * grp.drive_share;
         let w0 = st.group_spin[g];
         let x = grp.inertia * w0 / h + drive + loads.torque[g];
         let denom = grp.inertia / h + loads.stiffness[g];
@@ -217,8 +223,61 @@ pub(crate) fn solve_spins(
         };
         st.group_spin[g] = w1;
         group_reaction[g] = -(drive + brake_applied) / grp.wheels.len() as f64;
+        rhs[g] = x + brake_applied;
+        factor[g] = denom;
+        held[g] = x.abs() <= brake_max;
+    }
+    if spec.steering.kind == SteeringKind::Skid {
+        hold_speed_ratio(spec, model, st, &rhs, &factor, &held, &mut group_reaction);
     }
     group_reaction
+}
+
+/// The steer unit of a skid-steered vehicle: it holds the inner side's spin at ρ times the
+/// outer side's ([`skid_speed_ratio`]; ρ = 1 going straight, so the tracks cannot drift
+/// apart), like a hydrostatic or geared steer unit rather than a brake that only slows one
+/// side. The constraint ω_in − ρ ω_out = 0 acts with torque λ on the inner side and −ρ λ on
+/// the outer (no work while it holds: power passes from the inner side to the outer). With
+/// each side's implicit equation f·ω = r, λ = (ρ r_out / f_out − r_in / f_in) / (1 / f_in +
+/// ρ² / f_out), limited to the steering brake's capacity `skid_brake_torque` per wheel of the
+/// inner side, beyond which the unit slips and the vehicle turns wider. While the brakes hold
+/// a side still the unit does nothing.
+#[inline]
+fn hold_speed_ratio(
+    spec: &VehicleSpec,
+    model: &Model,
+    st: &mut SimState,
+    rhs: &[f64; MAX_WHEELS],
+    factor: &[f64; MAX_WHEELS],
+    held: &[bool; MAX_WHEELS],
+    group_reaction: &mut [f64; MAX_WHEELS],
+) {
+    let (Some(left), Some(right)) = (
+        model.groups.iter().position(|g| g.side > 0.0),
+        model.groups.iter().position(|g| g.side < 0.0),
+    ) else {
+        return;
+    };
+    if held[left] || held[right] {
+        return;
+    }
+    // positive steering turns left: the left side is the inner one
+    let (inner, outer) = if st.steer >= 0.0 {
+        (left, right)
+    } else {
+        (right, left)
+    };
+    let rho = skid_speed_ratio(spec, st.steer);
+    let (f_in, f_out) = (factor[inner], factor[outer]);
+    let n_in = model.groups[inner].wheels.len() as f64;
+    let capacity = spec.steering.skid_brake_torque * n_in;
+    let lambda = ((rho * rhs[outer] / f_out - rhs[inner] / f_in)
+        / (1.0 / f_in + rho * rho / f_out))
+        .clamp(-capacity, capacity);
+    st.group_spin[inner] = (rhs[inner] + lambda) / f_in;
+    st.group_spin[outer] = (rhs[outer] - rho * lambda) / f_out;
+    group_reaction[inner] -= lambda / n_in;
+    group_reaction[outer] += rho * lambda / model.groups[outer].wheels.len() as f64;
 }
 
 /// Most passes of the stick/slide decision in [`solve_spins_coulomb`].

@@ -56,6 +56,7 @@ pub mod testing;
 mod tyre;
 pub mod vehicles;
 
+pub use drivetrain::skid_speed_ratio;
 pub use error::{SimError, SpecError};
 pub use sim::Sim;
 pub use soil::SoilState;

@@ -69,7 +69,7 @@ pub(crate) struct SpinGroup {
     pub inertia: f64,
     /// Share of the engine torque.
     pub drive_share: f64,
-    /// Side for skid steering (+1 left, −1 right, 0 mixed).
+    /// Side, for the skid-steer unit (+1 left, −1 right, 0 mixed).
     pub side: f64,
     pub driven: bool,
 }

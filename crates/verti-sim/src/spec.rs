@@ -203,8 +203,11 @@ pub struct TyreSpec {
 pub enum SteeringKind {
     /// Steered wheels turn with Ackermann geometry about the rear (unsteered) axles.
     Ackermann,
-    /// Skid (differential) steering: the steering input biases drive torque between the sides
-    /// and brakes the inner side (tracked vehicles).
+    /// Skid (differential) steering: no wheel turns; a steer unit holds the inner side's speed
+    /// at a ratio of the outer side's so that the vehicle follows the path curvature of an
+    /// equivalent bicycle (wheelbase [`VehicleSpec::wheelbase`], steer angle up to
+    /// `max_angle_deg`): the same steering input means the same path for every vehicle
+    /// (tracked vehicles; see `drivetrain::skid_speed_ratio`).
     Skid,
 }
 
@@ -212,13 +215,15 @@ pub enum SteeringKind {
 #[serde(deny_unknown_fields)]
 pub struct SteeringSpec {
     pub kind: SteeringKind,
-    /// Ackermann: bicycle-model (centre) road-wheel angle at full input \[deg\].
+    /// Bicycle-model angle at full input \[deg\]: Ackermann, the road wheels' centre angle;
+    /// skid, the equivalent bicycle's.
     #[serde(default)]
     pub max_angle_deg: f64,
-    /// Ackermann: slew-rate limit of the centre angle \[deg/s\].
+    /// Slew-rate limit of that angle \[deg/s\].
     #[serde(default)]
     pub rate_deg_per_s: f64,
-    /// Skid: brake torque on the inner side at full input, per wheel \[N m\].
+    /// Skid: torque capacity of the steer unit's brake, per wheel of the inner side \[N m\];
+    /// beyond it the unit slips and the vehicle turns wider than asked.
     #[serde(default)]
     pub skid_brake_torque: f64,
 }
@@ -495,18 +500,15 @@ impl VehicleSpec {
             }
         }
         let st = &self.steering;
+        if !(st.max_angle_deg.is_finite() && st.max_angle_deg > 0.0 && st.max_angle_deg < 80.0) {
+            return Err(bad(
+                "steering.max_angle_deg".into(),
+                format!("{} must be in (0, 80)", st.max_angle_deg),
+            ));
+        }
+        pos("steering.rate_deg_per_s", st.rate_deg_per_s)?;
         match st.kind {
             SteeringKind::Ackermann => {
-                if !(st.max_angle_deg.is_finite()
-                    && st.max_angle_deg > 0.0
-                    && st.max_angle_deg < 80.0)
-                {
-                    return Err(bad(
-                        "steering.max_angle_deg".into(),
-                        format!("{} must be in (0, 80)", st.max_angle_deg),
-                    ));
-                }
-                pos("steering.rate_deg_per_s", st.rate_deg_per_s)?;
                 if !self.axles.iter().any(|a| a.steered) {
                     return Err(bad(
                         "axles".into(),
@@ -521,7 +523,15 @@ impl VehicleSpec {
                 }
             }
             SteeringKind::Skid => {
-                nonneg("steering.skid_brake_torque", st.skid_brake_torque)?;
+                pos("steering.skid_brake_torque", st.skid_brake_torque)?;
+                if self.wheelbase() <= 0.0 {
+                    return Err(bad(
+                        "axles".into(),
+                        "skid steering needs axles at more than one x (the equivalent bicycle's \
+                         wheelbase is the first axle's x minus the last's)"
+                            .into(),
+                    ));
+                }
                 if self.axles.iter().any(|a| a.steered) {
                     return Err(bad(
                         "axles".into(),

@@ -133,7 +133,9 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension_families: &["tensioned"],
             steering_families: &["differential"],
             suspension: "torsion-arm road wheels on a tensioned track, modelled as independent road wheels tied to one spin per side",
-            steering: "differential (skid) steering: torque bias and inner-side braking",
+            steering: "differential (skid) steering: a steer unit holds the inner track at the speed \
+                       ratio that gives the path of an equivalent bicycle (the HMMWV's minimum radius \
+                       at full input), with a limited steer-brake torque",
             source: "Chrono M113 (physics_spec §3.3); torsion rate, dampers, gears chosen",
         },
         "uaz" => Mechanisms {
@@ -281,7 +283,13 @@ impl VehicleSpec {
             SteeringKind::Skid => {
                 let _ = writeln!(
                     s,
-                    "  steering         skid, inner-side brake {:.0} N m per wheel",
+                    "  steering         skid: a steer unit holds the tracks' speed ratio for the path of \
+                     a bicycle of wheelbase {:.2} m at up to {:.1}° ({:.1} m minimum radius), {:.0}°/s; \
+                     steer brake {:.0} N m per wheel",
+                    self.wheelbase(),
+                    self.steering.max_angle_deg,
+                    self.wheelbase() / self.steering.max_angle_deg.to_radians().tan(),
+                    self.steering.rate_deg_per_s,
                     self.steering.skid_brake_torque
                 );
             }
