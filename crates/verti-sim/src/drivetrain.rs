@@ -13,10 +13,20 @@ use crate::state::{Controls, SimState};
 
 // ---- steering ----
 
+/// How the steered wheels point in an internal step.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WheelSteer {
+    /// Ackermann: the turn radius of the rear-axle centre (infinite when straight, for skid
+    /// steering and for a linkage).
+    pub turn_radius: f64,
+    /// Linkage: (sin δ, cos δ) of the left and right steered wheels' angles.
+    pub linkage: Option<[(f64, f64); 2]>,
+}
+
 /// Moves the steering toward the driver's input at the steering's slew rate: the bicycle-model
-/// angle, for Ackermann steering the road wheels' centre angle and for skid steering the
-/// equivalent bicycle's (see [`skid_speed_ratio`]). Returns the turn radius of the rear-axle
-/// centre (infinite when straight or skid-steered: no road wheel turns).
+/// angle, for Ackermann steering the road wheels' centre angle, for skid steering the
+/// equivalent bicycle's (see [`skid_speed_ratio`]), and for a linkage its input times the
+/// linkage's bicycle angle at full input. Returns how the steered wheels point.
 #[inline]
 pub(crate) fn steer(
     spec: &VehicleSpec,
@@ -24,11 +34,30 @@ pub(crate) fn steer(
     st: &mut SimState,
     ctl: &Controls,
     h: f64,
-) -> f64 {
+) -> WheelSteer {
     let target = ctl.steering * spec.steering.max_angle_deg.to_radians();
     let max_delta = spec.steering.rate_deg_per_s.to_radians() * h;
     st.steer += (target - st.steer).clamp(-max_delta, max_delta);
-    turn_radius(spec, model, st.steer)
+    wheel_steer(spec, model, st.steer)
+}
+
+/// How the steered wheels point for the bicycle angle `steer`.
+#[inline]
+pub(crate) fn wheel_steer(spec: &VehicleSpec, model: &Model, steer: f64) -> WheelSteer {
+    let linkage = spec.steering.linkage.as_ref().map(|l| {
+        let input = steer / spec.steering.max_angle_deg.to_radians();
+        // validation checked that the linkage closes over the whole input range
+        let (left, right) =
+            crate::linkage::wheel_angles(l, input.clamp(-1.0, 1.0)).unwrap_or((0.0, 0.0));
+        [
+            (libm::sin(left), libm::cos(left)),
+            (libm::sin(right), libm::cos(right)),
+        ]
+    });
+    WheelSteer {
+        turn_radius: turn_radius(spec, model, steer),
+        linkage,
+    }
 }
 
 /// Skid steering's speed ratio ρ = inner / outer track speed for the equivalent bicycle angle
@@ -57,9 +86,17 @@ pub(crate) fn turn_radius(spec: &VehicleSpec, model: &Model, steer: f64) -> f64 
 
 /// (sin δ, cos δ) of a wheel's steer angle δ. Ackermann: the wheel points at the turn centre
 /// on the rear-axle line, so tan δ = dx / (R − y); sine and cosine follow without
-/// trigonometric calls.
+/// trigonometric calls. Linkage: the linkage's angle for the wheel's side.
 #[inline]
-pub(crate) fn ackermann_sin_cos(m: &WheelModel, turn_radius: f64) -> (f64, f64) {
+pub(crate) fn steer_sin_cos(m: &WheelModel, steer: &WheelSteer) -> (f64, f64) {
+    if let Some(sides) = &steer.linkage {
+        return if m.steered {
+            sides[usize::from(m.y < 0.0)]
+        } else {
+            (0.0, 1.0)
+        };
+    }
+    let turn_radius = steer.turn_radius;
     if m.steered && turn_radius.is_finite() {
         let d = turn_radius - m.y;
         let hyp = (m.ackermann_dx * m.ackermann_dx + d * d).sqrt();
@@ -71,7 +108,12 @@ pub(crate) fn ackermann_sin_cos(m: &WheelModel, turn_radius: f64) -> (f64, f64) 
 
 /// A wheel's steer angle \[rad\] (an output only).
 #[inline]
-pub(crate) fn ackermann_angle(m: &WheelModel, turn_radius: f64) -> f64 {
+pub(crate) fn steer_angle(m: &WheelModel, steer: &WheelSteer) -> f64 {
+    if steer.linkage.is_some() {
+        let (sin, cos) = steer_sin_cos(m, steer);
+        return libm::atan2(sin, cos);
+    }
+    let turn_radius = steer.turn_radius;
     if m.steered && turn_radius.is_finite() {
         libm::atan(m.ackermann_dx / (turn_radius - m.y))
     } else {

@@ -41,6 +41,7 @@ mod drivetrain;
 mod error;
 mod friction;
 mod integrate;
+pub mod linkage;
 mod math;
 mod model;
 mod sim;

@@ -209,6 +209,43 @@ pub enum SteeringKind {
     /// `max_angle_deg`): the same steering input means the same path for every vehicle
     /// (tracked vehicles; see `drivetrain::skid_speed_ratio`).
     Skid,
+    /// The steered axle's wheels turn through a steering linkage (`linkage`): a rack and
+    /// pinion or a Pitman arm, each wheel by the angle the linkage gives it (see `linkage`).
+    Linkage,
+}
+
+/// The mechanism that moves the tie rods' inner joints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LinkageKind {
+    /// A rack across the vehicle, moved by `rack_travel` at full input (to the right for a
+    /// left turn, the tie rods behind the kingpins).
+    RackAndPinion,
+    /// A Pitman arm of `arm_length` along +x, turned by `arm_max_angle_deg` at full input, and
+    /// an idler arm like it: the centre link they carry keeps its direction (a parallelogram).
+    PitmanArm,
+}
+
+/// A steering linkage in the ground plane, by its points on the left side (the right side is
+/// its mirror image), in the vehicle's reference frame \[m\]: x forward, y left.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinkageSpec {
+    pub kind: LinkageKind,
+    /// Where the kingpin (steering axis) meets the plane of the tie rods.
+    pub kingpin: [f64; 2],
+    /// The steering arm's end on the knuckle (the tie rod's outer joint), wheels straight.
+    pub steering_arm: [f64; 2],
+    /// The tie rod's inner joint on the rack or centre link, wheels straight.
+    pub tie_rod_inner: [f64; 2],
+    /// Rack and pinion: the rack's travel at full input \[m\].
+    #[serde(default)]
+    pub rack_travel: f64,
+    /// Pitman arm: its length \[m\] and its rotation at full input \[deg\].
+    #[serde(default)]
+    pub arm_length: f64,
+    #[serde(default)]
+    pub arm_max_angle_deg: f64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -226,6 +263,9 @@ pub struct SteeringSpec {
     /// beyond it the unit slips and the vehicle turns wider than asked.
     #[serde(default)]
     pub skid_brake_torque: f64,
+    /// Linkage: the steering linkage (absent for the other kinds).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub linkage: Option<LinkageSpec>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -507,8 +547,63 @@ impl VehicleSpec {
             ));
         }
         pos("steering.rate_deg_per_s", st.rate_deg_per_s)?;
+        if st.linkage.is_some() != (st.kind == SteeringKind::Linkage) {
+            return Err(bad(
+                "steering.linkage".into(),
+                "a linkage is given with `kind: linkage`, and only then".into(),
+            ));
+        }
+        if let Some(l) = &st.linkage {
+            let points = [
+                ("kingpin", l.kingpin),
+                ("steering_arm", l.steering_arm),
+                ("tie_rod_inner", l.tie_rod_inner),
+            ];
+            for (name, p) in points {
+                if !(p[0].is_finite() && p[1].is_finite() && p[1] > 0.0) {
+                    return Err(bad(
+                        format!("steering.linkage.{name}"),
+                        format!("{p:?} must be a finite point on the left side (y > 0)"),
+                    ));
+                }
+            }
+            match l.kind {
+                LinkageKind::RackAndPinion => pos("steering.linkage.rack_travel", l.rack_travel)?,
+                LinkageKind::PitmanArm => {
+                    pos("steering.linkage.arm_length", l.arm_length)?;
+                    if !(l.arm_max_angle_deg > 0.0 && l.arm_max_angle_deg < 90.0) {
+                        return Err(bad(
+                            "steering.linkage.arm_max_angle_deg".into(),
+                            format!("{} must be in (0, 90)", l.arm_max_angle_deg),
+                        ));
+                    }
+                }
+            }
+            crate::linkage::check(l).map_err(|e| bad("steering.linkage".into(), e))?;
+            if self.axles.iter().filter(|a| a.steered).count() != 1 {
+                return Err(bad(
+                    "axles".into(),
+                    "a steering linkage steers exactly one axle".into(),
+                ));
+            }
+            // the systems plan with a bicycle of `max_angle_deg`: it must be the linkage's
+            let (left, right) = crate::linkage::wheel_angles(l, 1.0).unwrap_or_default();
+            let full = crate::linkage::bicycle_angle(left, right).to_degrees();
+            if (full - st.max_angle_deg).abs() > 0.5 {
+                return Err(bad(
+                    "steering.max_angle_deg".into(),
+                    format!(
+                        "{} is not the linkage's bicycle angle at full input, {full:.2}° (left \
+                         wheel {:.2}°, right {:.2}°)",
+                        st.max_angle_deg,
+                        left.to_degrees(),
+                        right.to_degrees()
+                    ),
+                ));
+            }
+        }
         match st.kind {
-            SteeringKind::Ackermann => {
+            SteeringKind::Ackermann | SteeringKind::Linkage => {
                 if !self.axles.iter().any(|a| a.steered) {
                     return Err(bad(
                         "axles".into(),

@@ -60,9 +60,9 @@ impl Sim {
             }
         }
         // per-wheel steer angles are outputs only: computed once per call, not per internal step
-        let turn_radius = drivetrain::turn_radius(&self.spec, &self.model, state.steer);
+        let wheel_steer = drivetrain::wheel_steer(&self.spec, &self.model, state.steer);
         for (m, w) in self.model.wheels.iter().zip(state.wheels.iter_mut()) {
-            w.steer_angle = drivetrain::ackermann_angle(m, turn_radius);
+            w.steer_angle = drivetrain::steer_angle(m, &wheel_steer);
         }
         state.check(scale)
     }
@@ -74,7 +74,7 @@ impl Sim {
         let gravity = Vec3::new(0.0, 0.0, -GRAVITY);
 
         // ---- driver: steering, engine and gearbox ----
-        let turn_radius = drivetrain::steer(spec, model, st, ctl, h);
+        let wheel_steer = drivetrain::steer(spec, model, st, ctl, h);
         let wheel_torque = drivetrain::engine(spec, model, st, ctl.throttle);
 
         // ---- wheels: contact, suspension, tyre forces (the longitudinal one waits for the
@@ -88,7 +88,7 @@ impl Sim {
         if rigid {
             let stage = RigidStage {
                 frame: &frame,
-                turn_radius,
+                wheel_steer,
                 wheel_torque,
                 near,
                 h,
@@ -100,7 +100,7 @@ impl Sim {
             let mut axles = [Vec3::ZERO; MAX_WHEELS];
             for (w, m) in model.wheels.iter().enumerate() {
                 let ws = st.wheels[w];
-                let kin = frame.wheel(st, m, &ws, turn_radius);
+                let kin = frame.wheel(st, m, &ws, &wheel_steer);
                 let soil_b = ws.soil_patch_b;
                 let contact =
                     wheel_contact(terrain, &mut st.soil, &spec.tyre, m, soil_b, &kin, near);
@@ -180,7 +180,7 @@ pub(crate) struct Frame {
 /// What the rigid tyres' stages need of the internal step ([`crate::step_rigid`]).
 pub(crate) struct RigidStage<'a> {
     pub frame: &'a Frame,
-    pub turn_radius: f64,
+    pub wheel_steer: drivetrain::WheelSteer,
     pub wheel_torque: f64,
     /// Obstacles near the vehicle.
     pub near: &'a [u32],
@@ -208,9 +208,9 @@ impl Frame {
         st: &SimState,
         m: &WheelModel,
         ws: &WheelState,
-        turn_radius: f64,
+        steer: &drivetrain::WheelSteer,
     ) -> WheelKinematics {
-        let (sin_steer, cos_steer) = drivetrain::ackermann_sin_cos(m, turn_radius);
+        let (sin_steer, cos_steer) = drivetrain::steer_sin_cos(m, steer);
         let arm = self.q.rotate(m.attach + Vec3::Z * ws.compression);
         WheelKinematics {
             arm,

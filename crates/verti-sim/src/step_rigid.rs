@@ -54,7 +54,7 @@ impl Sim {
         let none = TyreForces::default();
         for (w, m) in model.wheels.iter().enumerate() {
             let ws = st.wheels[w];
-            let kin = frame.wheel(st, m, &ws, stage.turn_radius);
+            let kin = frame.wheel(st, m, &ws, &stage.wheel_steer);
             let soil_b = ws.soil_patch_b;
             let near = stage.near;
             let (contact, rigid) =

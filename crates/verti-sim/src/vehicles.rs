@@ -115,7 +115,8 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension_families: &["double wishbone"],
             steering_families: &["pitman arm"],
             suspension: "double wishbone, modelled as independent wheels",
-            steering: "Pitman arm, modelled as Ackermann geometry",
+            steering: "Pitman arm and idler: each wheel's angle from the linkage's geometry (27.9° \
+                       inner / 22.0° outer at full lock)",
             source: "Chrono ARTcar (physics_spec §3.2); COM, wheel rate, motor voltage chosen",
         },
         "verti4" => Mechanisms {
@@ -154,7 +155,8 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             steering_families: &["rack-and-pinion"],
             suspension: "single wishbone in front (wheel rate from the strut's motion ratio 0.62), \
                          rigid rear axle (a spring as stiff as the step allows)",
-            steering: "rack and pinion, modelled as Ackermann geometry up to the 25° road-wheel angle",
+            steering: "rack and pinion: each wheel's angle from the linkage's geometry (parallel \
+                       steer, 45.1° inner / 43.9° outer at full lock)",
             source: "Chrono Gator (src/chrono_models/vehicle/gator, data/vehicle/gator/json)",
         },
         "sedan" => Mechanisms {
@@ -164,7 +166,8 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension: "double wishbone in front, multilink rear (upper A-arm, lateral, trailing \
                          and toe links), modelled as independent wheels at their wheel rates (coil \
                          motion ratios 0.519 front, 0.612 rear, by virtual work)",
-            steering: "rack and pinion, modelled as Ackermann geometry up to the 25° road-wheel angle",
+            steering: "rack and pinion: each wheel's angle from the linkage's geometry \
+                       (anti-Ackermann, 34.5° inner / 36.0° outer at full lock)",
             source: "Chrono Sedan, C++ model (src/chrono_models/vehicle/sedan)",
         },
         _ => return None,
@@ -279,6 +282,30 @@ impl VehicleSpec {
                     "  steering         Ackermann, max {:.1}°, {:.0}°/s",
                     self.steering.max_angle_deg, self.steering.rate_deg_per_s
                 );
+            }
+            SteeringKind::Linkage => {
+                if let Some(l) = &self.steering.linkage {
+                    let (left, right) = crate::linkage::wheel_angles(l, 1.0).unwrap_or((0.0, 0.0));
+                    let (inner, outer) = (left.to_degrees(), right.to_degrees());
+                    // the outer angle ideal Ackermann geometry would give for this inner one
+                    let kingpins = 2.0 * l.kingpin[1];
+                    let ideal = (1.0 / (1.0 / left.tan() + kingpins / self.wheelbase()))
+                        .atan()
+                        .to_degrees();
+                    let mechanism = match l.kind {
+                        crate::spec::LinkageKind::RackAndPinion => "rack and pinion",
+                        crate::spec::LinkageKind::PitmanArm => "Pitman arm",
+                    };
+                    let _ = writeln!(
+                        s,
+                        "  steering         {mechanism} linkage: at full lock inner {inner:.1}°, \
+                         outer {outer:.1}° (ideal Ackermann {ideal:.1}°; error {:+.1}°), bicycle \
+                         {:.2}°, {:.0}°/s",
+                        outer - ideal,
+                        crate::linkage::bicycle_angle(left, right).to_degrees(),
+                        self.steering.rate_deg_per_s
+                    );
+                }
             }
             SteeringKind::Skid => {
                 let _ = writeln!(

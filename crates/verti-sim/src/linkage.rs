@@ -1,0 +1,114 @@
+//! Steering linkages: the two road-wheel angles a rack and pinion or a Pitman arm gives for a
+//! steering input, from the linkage's points in the ground plane.
+//!
+//! Each side is a four-bar "crank": the knuckle turns about its kingpin K, its steering arm
+//! ends at T (the tie rod's outer joint), and a tie rod of fixed length joins T to a point C on
+//! the rack or the centre link. The driver moves C (a rack translates across the vehicle; a
+//! Pitman arm and its idler swing the centre link on a parallelogram), and the knuckle's
+//! rotation follows in closed form: with D = C − K, ρ = |D|, arm length r and rod length l,
+//! the arm's new direction is atan2(D) ± acos((r² + ρ² − l²) / (2 r ρ)), the branch the one
+//! the linkage is assembled in. Left and right are mirror images, so the two wheels turn by
+//! different angles: the linkage's Ackermann error, which ideal Ackermann geometry
+//! (cot δ_o − cot δ_i = d / L) would not have. Kingpin inclination, caster and the suspension's
+//! travel are neglected (within 0.1–0.3° of Chrono's full three-dimensional joints for the
+//! Gator and the Sedan, 0.7° for the ARTcar, up to 2° for the HMMWV's tilted steering box).
+
+use crate::spec::{LinkageKind, LinkageSpec};
+
+/// Planar point \[m\]: x forward, y left.
+type P2 = [f64; 2];
+
+/// The knuckle's rotation \[rad, positive = toward the left\] when the tie rod's inner joint
+/// moves from `inner0` to `inner`, the arm ending at `arm0` when the knuckle is straight; `None`
+/// where the linkage cannot close (the rod is too short or too long to reach).
+fn knuckle_rotation(kingpin: P2, arm0: P2, inner0: P2, inner: P2) -> Option<f64> {
+    let a0 = [arm0[0] - kingpin[0], arm0[1] - kingpin[1]];
+    let d0 = [inner0[0] - kingpin[0], inner0[1] - kingpin[1]];
+    let d = [inner[0] - kingpin[0], inner[1] - kingpin[1]];
+    let r = a0[0].hypot(a0[1]);
+    let rod = (arm0[0] - inner0[0]).hypot(arm0[1] - inner0[1]);
+    let rho = d[0].hypot(d[1]);
+    // the branch the linkage is assembled in: which side of K→C the arm lies on
+    let branch = if d0[0] * a0[1] - d0[1] * a0[0] >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    };
+    let cos_gamma = (r * r + rho * rho - rod * rod) / (2.0 * r * rho);
+    if cos_gamma.is_nan() || cos_gamma.abs() > 1.0 {
+        return None;
+    }
+    let phi = libm::atan2(d[1], d[0]) + branch * libm::acos(cos_gamma) - libm::atan2(a0[1], a0[0]);
+    Some(libm::atan2(libm::sin(phi), libm::cos(phi)))
+}
+
+/// How far the tie rods' inner joints move \[m\] (x, y) for input `u` in \[−1, 1\] (positive =
+/// left turn): a rack moves to the right by `u` times its travel; a Pitman arm of length a
+/// along +x, turned by −u·θ_max, carries the centre link by (a(cos θ − 1), −a sin θ).
+fn inner_joint_shift(l: &LinkageSpec, u: f64) -> P2 {
+    match l.kind {
+        LinkageKind::RackAndPinion => [0.0, -u * l.rack_travel],
+        LinkageKind::PitmanArm => {
+            let theta = u * l.arm_max_angle_deg.to_radians();
+            [
+                l.arm_length * (libm::cos(theta) - 1.0),
+                -l.arm_length * libm::sin(theta),
+            ]
+        }
+    }
+}
+
+/// The left and right road-wheel angles \[rad, positive = toward the left\] for input `u` in
+/// \[−1, 1\]; `None` where the linkage cannot close.
+pub fn wheel_angles(l: &LinkageSpec, u: f64) -> Option<(f64, f64)> {
+    let shift = inner_joint_shift(l, u);
+    let mirror = |p: P2| [p[0], -p[1]];
+    let left = knuckle_rotation(
+        l.kingpin,
+        l.steering_arm,
+        l.tie_rod_inner,
+        [l.tie_rod_inner[0] + shift[0], l.tie_rod_inner[1] + shift[1]],
+    )?;
+    let inner_right = mirror(l.tie_rod_inner);
+    let right = knuckle_rotation(
+        mirror(l.kingpin),
+        mirror(l.steering_arm),
+        inner_right,
+        [inner_right[0] + shift[0], inner_right[1] + shift[1]],
+    )?;
+    Some((left, right))
+}
+
+/// The bicycle angle \[rad\] equivalent to two road-wheel angles: the mean of their
+/// cotangents, cot δ_c = (cot δ_l + cot δ_r) / 2 (the centre of the two wheels' turn circles;
+/// exact for ideal Ackermann geometry).
+pub fn bicycle_angle(left: f64, right: f64) -> f64 {
+    if left == 0.0 || right == 0.0 {
+        return 0.0;
+    }
+    let (tl, tr) = (libm::tan(left), libm::tan(right));
+    libm::atan(2.0 * tl * tr / (tl + tr))
+}
+
+/// Why a linkage cannot serve as steering, if it cannot: it must close over the whole input
+/// range and turn both wheels one way, further the more the input.
+pub(crate) fn check(l: &LinkageSpec) -> Result<(), String> {
+    let mut last = (-f64::INFINITY, -f64::INFINITY);
+    for k in -100..=100 {
+        let u = f64::from(k) / 100.0;
+        let Some((left, right)) = wheel_angles(l, u) else {
+            return Err(format!(
+                "the linkage cannot close at steering input {u:.2} (a tie rod is too short or too \
+                 long for the arm to reach)"
+            ));
+        };
+        if left <= last.0 || right <= last.1 {
+            return Err(format!(
+                "the road-wheel angles do not grow with the input at {u:.2}: check the points' \
+                 sides (left side, y > 0) and the sign of the travel"
+            ));
+        }
+        last = (left, right);
+    }
+    Ok(())
+}

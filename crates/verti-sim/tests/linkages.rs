@@ -1,0 +1,112 @@
+//! Steering linkages (rack and pinion, Pitman arm) against their derivation: the road-wheel
+//! angles of the Gator's and the Sedan's racks and the ARTcar's Pitman arm, from Chrono's
+//! hardpoints projected on the ground plane, worked out independently of this code (a Python
+//! derivation of the same four-bar closed form from the hardpoints: left and right angles for
+//! inputs 0.25 to 1, to 0.01°), and the limits that follow from the geometry by hand.
+
+use verti_sim::linkage::{bicycle_angle, wheel_angles};
+use verti_sim::spec::{LinkageKind, LinkageSpec};
+use verti_sim::vehicles;
+
+fn linkage(name: &str) -> LinkageSpec {
+    vehicles::builtin(name).unwrap().steering.linkage.unwrap()
+}
+
+/// (input, left °, right °) from the derivation.
+fn check(name: &str, expected: &[(f64, f64, f64)]) {
+    let l = linkage(name);
+    for &(u, left, right) in expected {
+        let (l_deg, r_deg) = wheel_angles(&l, u)
+            .map(|(a, b)| (a.to_degrees(), b.to_degrees()))
+            .unwrap();
+        println!("{name} input {u}: left {l_deg:.3}°, right {r_deg:.3}° (derived {left}, {right})");
+        assert!(
+            (l_deg - left).abs() < 0.006,
+            "{name} {u}: left {l_deg} vs {left}"
+        );
+        assert!(
+            (r_deg - right).abs() < 0.006,
+            "{name} {u}: right {r_deg} vs {right}"
+        );
+        // mirror symmetry: a right turn is the left turn's mirror image
+        let (ml, mr) = wheel_angles(&l, -u).unwrap();
+        assert!((ml.to_degrees() + r_deg).abs() < 1e-9 && (mr.to_degrees() + l_deg).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn gator_rack_and_pinion() {
+    check(
+        "gator",
+        &[
+            (0.25, 10.08, 10.08),
+            (0.5, 20.51, 20.46),
+            (0.75, 31.81, 31.53),
+            (1.0, 45.07, 43.85),
+        ],
+    );
+    // by hand: the 0.05-m arm points straight back and the 0.27-m tie rod runs across, so
+    // without the rod's angularity sin δ = travel / arm: asin(0.035 / 0.05) = 44.4° at full lock
+    let (left, right) = wheel_angles(&linkage("gator"), 1.0).unwrap();
+    let hand = (0.035f64 / 0.05).asin();
+    assert!((left - hand).abs() < 1f64.to_radians() && (right - hand).abs() < 1f64.to_radians());
+}
+
+#[test]
+fn sedan_rack_and_pinion_is_anti_ackermann() {
+    check(
+        "sedan",
+        &[
+            (0.25, 8.38, 8.49),
+            (0.5, 16.78, 17.23),
+            (0.75, 25.39, 26.35),
+            (1.0, 34.48, 35.98),
+        ],
+    );
+    // its arm points back and outboard of the kingpin: the outer wheel turns more than the inner
+    let (inner, outer) = wheel_angles(&linkage("sedan"), 1.0).unwrap();
+    assert!(outer > inner);
+}
+
+#[test]
+fn artcar_pitman_arm() {
+    check(
+        "artcar",
+        &[
+            (0.25, 6.21, 5.93),
+            (0.5, 12.77, 11.60),
+            (0.75, 19.86, 16.99),
+            (1.0, 27.89, 22.05),
+        ],
+    );
+}
+
+/// With the arms straight back and the tie rods across (parallel steer) both wheels turn alike
+/// while the rods' angularity is small, as sin δ = travel / arm by hand; and the bicycle angle
+/// of two different wheel angles lies between them.
+#[test]
+fn parallel_steer_by_hand() {
+    let arm = 0.15f64;
+    let l = LinkageSpec {
+        kind: LinkageKind::RackAndPinion,
+        kingpin: [0.0, 0.75],
+        steering_arm: [-arm, 0.75],
+        tie_rod_inner: [-arm, 0.3],
+        rack_travel: 0.05,
+        arm_length: 0.0,
+        arm_max_angle_deg: 0.0,
+    };
+    let (a, b) = wheel_angles(&l, 0.2).unwrap();
+    let hand = (0.2f64 * 0.05 / arm).asin();
+    println!(
+        "parallel steer at 0.2: {:.3}° and {:.3}°, by hand {:.3}°",
+        a.to_degrees(),
+        b.to_degrees(),
+        hand.to_degrees()
+    );
+    assert!((a - b).abs() < 0.02 * a, "parallel steer: {a} vs {b}");
+    assert!((a - hand).abs() < 0.02 * hand && (b - hand).abs() < 0.02 * hand);
+    let (inner, outer) = wheel_angles(&linkage("artcar"), 1.0).unwrap();
+    let c = bicycle_angle(inner, outer);
+    assert!(c < inner && c > outer);
+}
