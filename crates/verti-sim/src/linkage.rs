@@ -1,5 +1,5 @@
-//! Steering linkages: the two road-wheel angles a rack and pinion or a Pitman arm gives for a
-//! steering input, from the linkage's points in the ground plane.
+//! Steering linkages: the two road-wheel angles a rack and pinion, a Pitman arm or a toe bar
+//! gives for a steering input, from the linkage's points in the ground plane.
 //!
 //! Each side is a four-bar "crank": the knuckle turns about its kingpin K, its steering arm
 //! ends at T (the tie rod's outer joint), and a tie rod of fixed length joins T to a point C on
@@ -7,7 +7,9 @@
 //! Pitman arm and its idler swing the centre link on a parallelogram), and the knuckle's
 //! rotation follows in closed form: with D = C − K, ρ = |D|, arm length r and rod length l,
 //! the arm's new direction is atan2(D) ± acos((r² + ρ² − l²) / (2 r ρ)), the branch the one
-//! the linkage is assembled in. Left and right are mirror images, so the two wheels turn by
+//! the linkage is assembled in. A toe bar chains two cranks: the drag link turns the left
+//! knuckle, and the toe bar between the steering arms turns the right one. Left and right
+//! sides are mirror images (a toe bar's drive is not, so its locks differ), and the two wheels turn by
 //! different angles: the linkage's Ackermann error, which ideal Ackermann geometry
 //! (cot δ_o − cot δ_i = d / L) would not have. Kingpin inclination, caster and the suspension's
 //! travel are neglected (within 0.1–0.3° of Chrono's full three-dimensional joints for the
@@ -55,21 +57,46 @@ fn inner_joint_shift(l: &LinkageSpec, u: f64) -> P2 {
                 -l.arm_length * libm::sin(theta),
             ]
         }
+        LinkageKind::ToeBar => [0.0, 0.0],
     }
+}
+
+/// `p` turned by `angle` about `centre`.
+fn rotate(p: P2, centre: P2, angle: f64) -> P2 {
+    let (s, c) = (libm::sin(angle), libm::cos(angle));
+    let (x, y) = (p[0] - centre[0], p[1] - centre[1]);
+    [centre[0] + c * x - s * y, centre[1] + s * x + c * y]
 }
 
 /// The left and right road-wheel angles \[rad, positive = toward the left\] for input `u` in
 /// \[−1, 1\]; `None` where the linkage cannot close.
 pub fn wheel_angles(l: &LinkageSpec, u: f64) -> Option<(f64, f64)> {
-    let shift = inner_joint_shift(l, u);
     let mirror = |p: P2| [p[0], -p[1]];
+    if l.kind == LinkageKind::ToeBar {
+        // the rotary arm hangs down: its end, and the drag link's, moves forward by a·sin θ;
+        // the drag link turns the left knuckle, whose toe-bar arm then turns the right one
+        let (drag_arm, drag_end, drag_kingpin) = (l.drag_arm?, l.drag_link_end?, l.drag_kingpin?);
+        let theta = u * l.arm_max_angle_deg.to_radians();
+        let moved = [drag_end[0] + l.arm_length * libm::sin(theta), drag_end[1]];
+        let left = knuckle_rotation(drag_kingpin, drag_arm, drag_end, moved)?;
+        let toe_left = rotate(l.steering_arm, l.kingpin, left);
+        let right = knuckle_rotation(
+            mirror(l.kingpin),
+            mirror(l.steering_arm),
+            l.steering_arm,
+            toe_left,
+        )?;
+        return Some((left, right));
+    }
+    let tie_rod_inner = l.tie_rod_inner?;
+    let shift = inner_joint_shift(l, u);
     let left = knuckle_rotation(
         l.kingpin,
         l.steering_arm,
-        l.tie_rod_inner,
-        [l.tie_rod_inner[0] + shift[0], l.tie_rod_inner[1] + shift[1]],
+        tie_rod_inner,
+        [tie_rod_inner[0] + shift[0], tie_rod_inner[1] + shift[1]],
     )?;
-    let inner_right = mirror(l.tie_rod_inner);
+    let inner_right = mirror(tie_rod_inner);
     let right = knuckle_rotation(
         mirror(l.kingpin),
         mirror(l.steering_arm),
@@ -77,6 +104,14 @@ pub fn wheel_angles(l: &LinkageSpec, u: f64) -> Option<(f64, f64)> {
         [inner_right[0] + shift[0], inner_right[1] + shift[1]],
     )?;
     Some((left, right))
+}
+
+/// The linkage's bicycle angle at full input \[rad\]: the mean of a full left and a full
+/// right turn's (they differ where the linkage is not symmetric, as a toe bar's drag link is).
+pub fn full_lock_bicycle_angle(l: &LinkageSpec) -> f64 {
+    let (l1, r1) = wheel_angles(l, 1.0).unwrap_or_default();
+    let (l2, r2) = wheel_angles(l, -1.0).unwrap_or_default();
+    0.5 * (bicycle_angle(l1, r1) - bicycle_angle(l2, r2))
 }
 
 /// The bicycle angle \[rad\] equivalent to two road-wheel angles: the mean of their

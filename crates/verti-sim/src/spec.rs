@@ -224,6 +224,11 @@ pub enum LinkageKind {
     /// A Pitman arm of `arm_length` along +x, turned by `arm_max_angle_deg` at full input, and
     /// an idler arm like it: the centre link they carry keeps its direction (a parallelogram).
     PitmanArm,
+    /// A solid axle's knuckles tied by a toe bar between their steering arms, the left knuckle
+    /// turned by a drag link from a rotary arm: the arm hangs `arm_length` down from a pivot
+    /// across the vehicle and turns by `arm_max_angle_deg` at full input, moving the drag
+    /// link's end forward for a left turn. Left and right locks differ.
+    ToeBar,
 }
 
 /// A steering linkage in the ground plane, by its points on the left side (the right side is
@@ -234,10 +239,21 @@ pub struct LinkageSpec {
     pub kind: LinkageKind,
     /// Where the kingpin (steering axis) meets the plane of the tie rods.
     pub kingpin: [f64; 2],
-    /// The steering arm's end on the knuckle (the tie rod's outer joint), wheels straight.
+    /// The steering arm's end on the knuckle (the tie rod's or toe bar's joint), wheels
+    /// straight.
     pub steering_arm: [f64; 2],
-    /// The tie rod's inner joint on the rack or centre link, wheels straight.
-    pub tie_rod_inner: [f64; 2],
+    /// Rack and pinion, Pitman arm: the tie rod's inner joint on the rack or centre link,
+    /// wheels straight.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tie_rod_inner: Option<[f64; 2]>,
+    /// Toe bar: the drag link's joint on the left knuckle, its other end on the rotary arm
+    /// (wheels straight), and the kingpin at the drag link's height.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drag_arm: Option<[f64; 2]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drag_link_end: Option<[f64; 2]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drag_kingpin: Option<[f64; 2]>,
     /// Rack and pinion: the rack's travel at full input \[m\].
     #[serde(default)]
     pub rack_travel: f64,
@@ -554,22 +570,47 @@ impl VehicleSpec {
             ));
         }
         if let Some(l) = &st.linkage {
+            let needed: &[&str] = match l.kind {
+                LinkageKind::RackAndPinion | LinkageKind::PitmanArm => &["tie_rod_inner"],
+                LinkageKind::ToeBar => &["drag_arm", "drag_link_end", "drag_kingpin"],
+            };
             let points = [
-                ("kingpin", l.kingpin),
-                ("steering_arm", l.steering_arm),
+                ("kingpin", Some(l.kingpin)),
+                ("steering_arm", Some(l.steering_arm)),
                 ("tie_rod_inner", l.tie_rod_inner),
+                ("drag_arm", l.drag_arm),
+                ("drag_link_end", l.drag_link_end),
+                ("drag_kingpin", l.drag_kingpin),
             ];
             for (name, p) in points {
-                if !(p[0].is_finite() && p[1].is_finite() && p[1] > 0.0) {
-                    return Err(bad(
-                        format!("steering.linkage.{name}"),
-                        format!("{p:?} must be a finite point on the left side (y > 0)"),
-                    ));
+                match p {
+                    None if needed.contains(&name) => {
+                        return Err(bad(
+                            format!("steering.linkage.{name}"),
+                            format!("missing: a {:?} linkage needs it", l.kind),
+                        ));
+                    }
+                    Some(_)
+                        if !needed.contains(&name)
+                            && !matches!(name, "kingpin" | "steering_arm") =>
+                    {
+                        return Err(bad(
+                            format!("steering.linkage.{name}"),
+                            format!("not used by a {:?} linkage", l.kind),
+                        ));
+                    }
+                    Some(p) if !(p[0].is_finite() && p[1].is_finite() && p[1] > 0.0) => {
+                        return Err(bad(
+                            format!("steering.linkage.{name}"),
+                            format!("{p:?} must be a finite point on the left side (y > 0)"),
+                        ));
+                    }
+                    _ => {}
                 }
             }
             match l.kind {
                 LinkageKind::RackAndPinion => pos("steering.linkage.rack_travel", l.rack_travel)?,
-                LinkageKind::PitmanArm => {
+                LinkageKind::PitmanArm | LinkageKind::ToeBar => {
                     pos("steering.linkage.arm_length", l.arm_length)?;
                     if !(l.arm_max_angle_deg > 0.0 && l.arm_max_angle_deg < 90.0) {
                         return Err(bad(
@@ -587,17 +628,14 @@ impl VehicleSpec {
                 ));
             }
             // the systems plan with a bicycle of `max_angle_deg`: it must be the linkage's
-            let (left, right) = crate::linkage::wheel_angles(l, 1.0).unwrap_or_default();
-            let full = crate::linkage::bicycle_angle(left, right).to_degrees();
-            if (full - st.max_angle_deg).abs() > 0.5 {
+            // (the mean of the two directions' where left and right locks differ)
+            let full = crate::linkage::full_lock_bicycle_angle(l).to_degrees();
+            if (full - st.max_angle_deg).abs() > 0.05 {
                 return Err(bad(
                     "steering.max_angle_deg".into(),
                     format!(
-                        "{} is not the linkage's bicycle angle at full input, {full:.2}° (left \
-                         wheel {:.2}°, right {:.2}°)",
-                        st.max_angle_deg,
-                        left.to_degrees(),
-                        right.to_degrees()
+                        "{} is not the linkage's bicycle angle at full input, {full:.2}°",
+                        st.max_angle_deg
                     ),
                 ));
             }

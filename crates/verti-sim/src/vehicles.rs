@@ -145,8 +145,9 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             steering_families: &["toe-bar", "bellcrank/rotary arm"],
             suspension: "leaf-spring solid axles (toe-bar axle in front), modelled as solid axles: \
                          wheels coupled through springs 1.028 m and dampers 0.882 m apart",
-            steering: "toe-bar axle steered by a drag link from a rotary Pitman arm, modelled as \
-                       Ackermann geometry up to the 27° road-wheel angle",
+            steering: "toe-bar axle steered by a drag link from a rotary Pitman arm: each wheel's \
+                       angle from the linkage's geometry (left lock 23.1° / 20.5°, right lock \
+                       26.5° / 23.1°, inner / outer)",
             source: "Chrono UAZ469 / UAZBUS (data/vehicle/uaz, src/chrono_models/vehicle/uaz)",
         },
         "gator" => Mechanisms {
@@ -285,24 +286,35 @@ impl VehicleSpec {
             }
             SteeringKind::Linkage => {
                 if let Some(l) = &self.steering.linkage {
-                    let (left, right) = crate::linkage::wheel_angles(l, 1.0).unwrap_or((0.0, 0.0));
-                    let (inner, outer) = (left.to_degrees(), right.to_degrees());
-                    // the outer angle ideal Ackermann geometry would give for this inner one
-                    let kingpins = 2.0 * l.kingpin[1];
-                    let ideal = (1.0 / (1.0 / left.tan() + kingpins / self.wheelbase()))
-                        .atan()
-                        .to_degrees();
                     let mechanism = match l.kind {
                         crate::spec::LinkageKind::RackAndPinion => "rack and pinion",
                         crate::spec::LinkageKind::PitmanArm => "Pitman arm",
+                        crate::spec::LinkageKind::ToeBar => "toe bar",
                     };
+                    let _ = write!(s, "  steering         {mechanism} linkage; at full lock");
+                    for (turn, u) in [("left", 1.0), ("right", -1.0)] {
+                        let (left, right) = crate::linkage::wheel_angles(l, u).unwrap_or_default();
+                        let (inner, outer) = if u > 0.0 {
+                            (left, right)
+                        } else {
+                            (-right, -left)
+                        };
+                        // the outer angle ideal Ackermann geometry gives for this inner one
+                        let kingpins = 2.0 * l.kingpin[1];
+                        let ideal =
+                            (1.0 / (1.0 / inner.tan() + kingpins / self.wheelbase())).atan();
+                        let _ = write!(
+                            s,
+                            " {turn}: inner {:.1}°, outer {:.1}° (ideal {:.1}°)",
+                            inner.to_degrees(),
+                            outer.to_degrees(),
+                            ideal.to_degrees()
+                        );
+                    }
                     let _ = writeln!(
                         s,
-                        "  steering         {mechanism} linkage: at full lock inner {inner:.1}°, \
-                         outer {outer:.1}° (ideal Ackermann {ideal:.1}°; error {:+.1}°), bicycle \
-                         {:.2}°, {:.0}°/s",
-                        outer - ideal,
-                        crate::linkage::bicycle_angle(left, right).to_degrees(),
+                        "; bicycle {:.2}°, {:.0}°/s",
+                        crate::linkage::full_lock_bicycle_angle(l).to_degrees(),
                         self.steering.rate_deg_per_s
                     );
                 }

@@ -1,5 +1,6 @@
-//! Steering linkages (rack and pinion, Pitman arm) against their derivation: the road-wheel
-//! angles of the Gator's and the Sedan's racks and the ARTcar's Pitman arm, from Chrono's
+//! Steering linkages (rack and pinion, Pitman arm, toe bar) against their derivation: the
+//! road-wheel angles of the Gator's and the Sedan's racks, the ARTcar's Pitman arm and the
+//! UAZ's toe bar, from Chrono's
 //! hardpoints projected on the ground plane, worked out independently of this code (a Python
 //! derivation of the same four-bar closed form from the hardpoints: left and right angles for
 //! inputs 0.25 to 1, to 0.01°), and the limits that follow from the geometry by hand.
@@ -68,6 +69,31 @@ fn sedan_rack_and_pinion_is_anti_ackermann() {
     assert!(outer > inner);
 }
 
+/// The UAZ's toe bar, driven on the left by a drag link: a left and a right turn differ.
+#[test]
+fn uaz_toe_bar() {
+    let l = linkage("uaz");
+    let expected = [
+        (0.25, 5.67, 5.51),
+        (0.5, 11.38, 10.75),
+        (0.75, 17.18, 15.75),
+        (1.0, 23.12, 20.53),
+        (-0.25, -5.67, -5.84),
+        (-0.5, -11.37, -12.08),
+        (-0.75, -17.15, -18.88),
+        (-1.0, -23.05, -26.47),
+    ];
+    for (u, left, right) in expected {
+        let (a, b) = wheel_angles(&l, u).unwrap();
+        let (a, b) = (a.to_degrees(), b.to_degrees());
+        println!("uaz input {u}: left {a:.3}°, right {b:.3}° (derived {left}, {right})");
+        assert!(
+            (a - left).abs() < 0.006 && (b - right).abs() < 0.006,
+            "uaz {u}: {a} {b}"
+        );
+    }
+}
+
 #[test]
 fn artcar_pitman_arm() {
     check(
@@ -91,7 +117,10 @@ fn parallel_steer_by_hand() {
         kind: LinkageKind::RackAndPinion,
         kingpin: [0.0, 0.75],
         steering_arm: [-arm, 0.75],
-        tie_rod_inner: [-arm, 0.3],
+        tie_rod_inner: Some([-arm, 0.3]),
+        drag_arm: None,
+        drag_link_end: None,
+        drag_kingpin: None,
         rack_travel: 0.05,
         arm_length: 0.0,
         arm_max_angle_deg: 0.0,

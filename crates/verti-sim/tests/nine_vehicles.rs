@@ -299,15 +299,16 @@ fn braking_distance_of_the_new_vehicles() {
     assert!((d - expected).abs() < 0.1 * expected);
 }
 
-// Steady low-speed cornering follows the steering's geometry. Ackermann (UAZ): at half input,
-// δ = max/2, the rear axle's centre circles at R = L / tan δ (L 2.38 m, δ 13.5°, R 9.9 m), within
-// 5 %. A linkage (Gator, Sedan: rack and pinion) does not point both wheels at one centre, so
-// its rigid tyres cannot all roll without slip. One front wheel can: it rolls on its own
-// circle, R_w = L / tan δ_w ∓ t/2 for the rear axle's centre (inner wheel −, outer +, t the
-// front track), and holds the other's sliding force while it sticks. So R lies between the two
-// wheels' radii (1 % margin); measured, it is the inner wheel's (Gator at half input: δ_i
-// 20.51°, R_i 5.75 m, R_o 4.64 m; Sedan: δ_i 16.78°, R_i 10.0 m, R_o 8.15 m). Speed ≈ 1.5 m/s by
-// throttle alone; open differentials, as a locked axle scrubs (a powertrain effect, not
+// Steady low-speed cornering follows the steering's geometry. With ideal Ackermann geometry
+// at half input, δ = max/2, the rear axle's centre circles at R = L / tan δ, within 5 %. The
+// three vehicles here steer through linkages (UAZ: toe bar; Gator, Sedan: rack and pinion),
+// which do not point both wheels at one centre, so their rigid tyres cannot all roll without
+// slip. One front wheel can: it rolls on its own circle, R_w = L / tan δ_w ∓ t/2 for the rear
+// axle's centre (inner wheel −, outer +, t the front track), and holds the other's sliding
+// force while it sticks. So R lies between the two wheels' radii (1 % margin); measured, it is
+// the inner wheel's (at half input, UAZ: δ_i 11.38°, R_i 12.56 m, R_o 11.81 m; Gator: δ_i
+// 20.51°, R_i 5.75 m, R_o 4.64 m; Sedan: δ_i 16.78°, R_i 10.0 m, R_o 8.15 m). Speed ≈ 1.5 m/s
+// by throttle alone; open differentials, as a locked axle scrubs (a powertrain effect, not
 // steering geometry).
 #[test]
 fn low_speed_cornering_of_the_new_vehicles() {
