@@ -7,7 +7,7 @@
 
 use crate::friction::{CoulombTyre, LongTyre};
 use crate::math::{RPM_TO_RAD_S, soft_sign};
-use crate::model::{Model, WheelModel};
+use crate::model::{LINKAGE_SAMPLES, Model, WheelModel};
 use crate::spec::{MAX_WHEELS, PowertrainSpec, SteeringKind, VehicleSpec};
 use crate::state::{Controls, SimState};
 
@@ -44,15 +44,21 @@ pub(crate) fn steer(
 /// How the steered wheels point for the bicycle angle `steer`.
 #[inline]
 pub(crate) fn wheel_steer(spec: &VehicleSpec, model: &Model, steer: f64) -> WheelSteer {
-    let linkage = spec.steering.linkage.as_ref().map(|l| {
-        let input = steer / spec.steering.max_angle_deg.to_radians();
-        // validation checked that the linkage closes over the whole input range
-        let (left, right) =
-            crate::linkage::wheel_angles(l, input.clamp(-1.0, 1.0)).unwrap_or((0.0, 0.0));
-        [
-            (libm::sin(left), libm::cos(left)),
-            (libm::sin(right), libm::cos(right)),
-        ]
+    let linkage = model.linkage_table.as_ref().map(|table| {
+        // the linkage's input; its table is interpolated linearly and the (sin, cos) pairs
+        // normalised again
+        let input = (steer / spec.steering.max_angle_deg.to_radians()).clamp(-1.0, 1.0);
+        let at = (input + 1.0) * 0.5 * LINKAGE_SAMPLES as f64;
+        let k = (at as usize).min(LINKAGE_SAMPLES - 1);
+        let t = at - k as f64;
+        let (a, b) = (&table[k], &table[k + 1]);
+        let side = |j: usize| {
+            let sin = a[j].0 + t * (b[j].0 - a[j].0);
+            let cos = a[j].1 + t * (b[j].1 - a[j].1);
+            let norm = (sin * sin + cos * cos).sqrt();
+            (sin / norm, cos / norm)
+        };
+        [side(0), side(1)]
     });
     WheelSteer {
         turn_radius: turn_radius(spec, model, steer),

@@ -104,7 +104,16 @@ pub(crate) struct Model {
     pub driven_wheels: usize,
     /// Distance from the first steered axle to the mean of the unsteered ones (Ackermann).
     pub wheelbase: f64,
+    /// A steering linkage's (sin δ, cos δ) of the left and right steered wheels at
+    /// [`LINKAGE_SAMPLES`] + 1 evenly spaced inputs from −1 to 1 (the closed form costs a
+    /// dozen trigonometric calls, too many for every internal step).
+    pub linkage_table: Option<Vec<[(f64, f64); 2]>>,
 }
+
+/// Intervals of [`Model::linkage_table`]: between samples the wheel angle changes by at most
+/// ~0.005 rad, so interpolating sine and cosine and normalising is within ~1e-6 rad of the
+/// closed form.
+pub(crate) const LINKAGE_SAMPLES: usize = 400;
 
 impl Model {
     /// Compiles a validated `spec` for a world of the given scale.
@@ -262,6 +271,20 @@ impl Model {
             soil_floor,
             driven_wheels,
             wheelbase,
+            linkage_table: spec.steering.linkage.as_ref().map(|l| {
+                (0..=LINKAGE_SAMPLES)
+                    .map(|k| {
+                        let u = -1.0 + 2.0 * k as f64 / LINKAGE_SAMPLES as f64;
+                        // validation checked that the linkage closes over the whole range
+                        let (left, right) =
+                            crate::linkage::wheel_angles(l, u).unwrap_or((0.0, 0.0));
+                        [
+                            (libm::sin(left), libm::cos(left)),
+                            (libm::sin(right), libm::cos(right)),
+                        ]
+                    })
+                    .collect()
+            }),
         }
     }
 }

@@ -139,3 +139,32 @@ fn parallel_steer_by_hand() {
     let c = bicycle_angle(inner, outer);
     assert!(c < inner && c > outer);
 }
+
+/// The engine turns the wheels by the linkage's angles: after the steering has slewed to an
+/// input, each steered wheel's angle is the closed form's within 1e-5 rad (the engine
+/// interpolates a table of 400 intervals, see `Model::linkage_table`).
+#[test]
+fn the_engine_steers_by_the_linkage() {
+    for name in ["gator", "sedan", "uaz", "artcar"] {
+        let spec = vehicles::builtin(name).unwrap();
+        let l = spec.steering.linkage.unwrap();
+        let world = verti_sim::testing::flat_world(spec.scale, 0.8);
+        let world = std::sync::Arc::new(world);
+        let sim = verti_sim::Sim::new(&world, &spec).unwrap();
+        for u in [-0.83, -0.3, 0.123, 0.6, 1.0] {
+            let mut st = sim
+                .state_at(verti_sim::StartPose::new(0.0, 0.0, 0.0))
+                .unwrap();
+            for _ in 0..200 {
+                sim.step(&mut st, verti_sim::Controls::new(0.0, 1.0, u), 0.01)
+                    .unwrap();
+            }
+            let (left, right) = wheel_angles(&l, u).unwrap();
+            let (a, b) = (st.wheels()[0].steer_angle, st.wheels()[1].steer_angle);
+            assert!(
+                (a - left).abs() < 1e-5 && (b - right).abs() < 1e-5,
+                "{name} at {u}: engine {a} / {b}, linkage {left} / {right}"
+            );
+        }
+    }
+}
