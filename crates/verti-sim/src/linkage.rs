@@ -15,7 +15,57 @@
 //! travel are neglected (within 0.1–0.3° of Chrono's full three-dimensional joints for the
 //! Gator and the Sedan, 0.7° for the ARTcar, up to 2° for the HMMWV's tilted steering box).
 
-use crate::spec::{LinkageKind, LinkageSpec};
+use serde::{Deserialize, Serialize};
+
+/// The mechanism that moves the tie rods' inner joints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LinkageKind {
+    /// A rack across the vehicle, moved by `rack_travel` at full input (to the right for a
+    /// left turn, the tie rods behind the kingpins).
+    RackAndPinion,
+    /// A Pitman arm of `arm_length` along +x, turned by `arm_max_angle_deg` at full input, and
+    /// an idler arm like it: the centre link they carry keeps its direction (a parallelogram).
+    PitmanArm,
+    /// A solid axle's knuckles tied by a toe bar between their steering arms, the left knuckle
+    /// turned by a drag link from a rotary arm: the arm hangs `arm_length` down from a pivot
+    /// across the vehicle and turns by `arm_max_angle_deg` at full input, moving the drag
+    /// link's end forward for a left turn. Left and right locks differ.
+    ToeBar,
+}
+
+/// A steering linkage in the ground plane, by its points on the left side (the right side is
+/// its mirror image), in the vehicle's reference frame \[m\]: x forward, y left.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinkageSpec {
+    pub kind: LinkageKind,
+    /// Where the kingpin (steering axis) meets the plane of the tie rods.
+    pub kingpin: [f64; 2],
+    /// The steering arm's end on the knuckle (the tie rod's or toe bar's joint), wheels
+    /// straight.
+    pub steering_arm: [f64; 2],
+    /// Rack and pinion, Pitman arm: the tie rod's inner joint on the rack or centre link,
+    /// wheels straight.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tie_rod_inner: Option<[f64; 2]>,
+    /// Toe bar: the drag link's joint on the left knuckle, its other end on the rotary arm
+    /// (wheels straight), and the kingpin at the drag link's height.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drag_arm: Option<[f64; 2]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drag_link_end: Option<[f64; 2]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drag_kingpin: Option<[f64; 2]>,
+    /// Rack and pinion: the rack's travel at full input \[m\].
+    #[serde(default)]
+    pub rack_travel: f64,
+    /// Pitman arm: its length \[m\] and its rotation at full input \[deg\].
+    #[serde(default)]
+    pub arm_length: f64,
+    #[serde(default)]
+    pub arm_max_angle_deg: f64,
+}
 
 /// Planar point \[m\]: x forward, y left.
 type P2 = [f64; 2];
