@@ -211,7 +211,7 @@ pub enum SteeringKind {
     /// (tracked vehicles; see `drivetrain::skid_speed_ratio`).
     Skid,
     /// The steered axle's wheels turn through a steering linkage (`linkage`): a rack and
-    /// pinion or a Pitman arm, each wheel by the angle the linkage gives it (see `linkage`).
+    /// pinion, a Pitman arm or a toe bar, each wheel by the angle the linkage gives it.
     Linkage,
 }
 

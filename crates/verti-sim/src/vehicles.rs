@@ -115,8 +115,7 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension_families: &["double wishbone"],
             steering_families: &["pitman arm"],
             suspension: "double wishbone, modelled as independent wheels",
-            steering: "Pitman arm and idler: each wheel's angle from the linkage's geometry (27.9° \
-                       inner / 22.0° outer at full lock)",
+            steering: "Pitman arm and idler: each wheel's angle from the linkage's geometry",
             source: "Chrono ARTcar (physics_spec §3.2); COM, wheel rate, motor voltage chosen",
         },
         "verti4" => Mechanisms {
@@ -146,8 +145,7 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension: "leaf-spring solid axles (toe-bar axle in front), modelled as solid axles: \
                          wheels coupled through springs 1.028 m and dampers 0.882 m apart",
             steering: "toe-bar axle steered by a drag link from a rotary Pitman arm: each wheel's \
-                       angle from the linkage's geometry (left lock 23.1° / 20.5°, right lock \
-                       26.5° / 23.1°, inner / outer)",
+                       angle from the linkage's geometry (left and right locks differ)",
             source: "Chrono UAZ469 / UAZBUS (data/vehicle/uaz, src/chrono_models/vehicle/uaz)",
         },
         "gator" => Mechanisms {
@@ -157,7 +155,7 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension: "single wishbone in front (wheel rate from the strut's motion ratio 0.62), \
                          rigid rear axle (a spring as stiff as the step allows)",
             steering: "rack and pinion: each wheel's angle from the linkage's geometry (parallel \
-                       steer, 45.1° inner / 43.9° outer at full lock)",
+                       steer)",
             source: "Chrono Gator (src/chrono_models/vehicle/gator, data/vehicle/gator/json)",
         },
         "sedan" => Mechanisms {
@@ -168,7 +166,7 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
                          and toe links), modelled as independent wheels at their wheel rates (coil \
                          motion ratios 0.519 front, 0.612 rear, by virtual work)",
             steering: "rack and pinion: each wheel's angle from the linkage's geometry \
-                       (anti-Ackermann, 34.5° inner / 36.0° outer at full lock)",
+                       (anti-Ackermann)",
             source: "Chrono Sedan, C++ model (src/chrono_models/vehicle/sedan)",
         },
         _ => return None,
