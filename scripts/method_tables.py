@@ -9,8 +9,9 @@ rollover, stuck and timeout (%), and the mean traversal time of the successful t
 with fewer than 1000 results says how many it has. Reads `benchmarks/verti-100/<run>/results.jsonl`.
 """
 
-import json
 from pathlib import Path
+
+from run_rows import rows, share, success_by_level
 
 PIETRA = [
     ("PIETRA (`pietra-v1`, dirt-only prior)", "pietra"),
@@ -33,15 +34,7 @@ VA = [
 ]
 
 
-def rows(run):
-    file = Path(__file__).resolve().parent.parent / "benchmarks" / "verti-100" / run / "results.jsonl"
-    if not file.exists():
-        return []
-    return [json.loads(line) for line in file.open() if line.strip()]
-
-
-def pct(part, whole):
-    return f"{100.0 * part / whole:.1f}" if whole else "—"
+RUNS = Path(__file__).resolve().parent.parent / "benchmarks" / "verti-100"
 
 
 def table(entries):
@@ -50,22 +43,18 @@ def table(entries):
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for label, run in entries:
-        rs = rows(run)
+        rs = rows(RUNS / run)
         if not rs:
             lines.append(f"| {label} | not run | | | | | | | |")
             continue
         n = len(rs)
-        count = lambda o: sum(r["outcome"] == o for r in rs)  # noqa: E731
-        levels = []
-        for level in ["low", "mid", "high"]:
-            at = [r for r in rs if r["level"] == level]
-            levels.append(pct(sum(r["outcome"] == "success" for r in at), len(at)))
+        levels = success_by_level(rs)
         times = [r["traversal_time"] for r in rs if r["outcome"] == "success" and r.get("traversal_time")]
         time = f"{sum(times) / len(times):.2f}" if times else "—"
         note = "" if n == 1000 else f" ({n} tasks)"
         lines.append(
-            f"| {label} | {pct(count('success'), n)} %{note} | {' | '.join(levels)} | "
-            f"{pct(count('rollover'), n)} | {pct(count('stuck'), n)} | {pct(count('timeout'), n)} | {time} |"
+            f"| {label} | {share(rs, 'success')} %{note} | {' | '.join(levels)} | "
+            f"{share(rs, 'rollover')} | {share(rs, 'stuck')} | {share(rs, 'timeout')} | {time} |"
         )
     return "\n".join(lines) + "\n"
 

@@ -10,8 +10,9 @@ per system: success, rollover and stuck (%) overall, and success per elevation l
 with fewer results than its table's task count says how many it has.
 """
 
-import json
 from pathlib import Path
+
+from run_rows import rows, share, success_by_level
 
 VEHICLES = [
     ("hmmwv", "1", "4 wheels, Ackermann (rigid tyres)"),
@@ -28,22 +29,10 @@ VEHICLES = [
 SUBSET = set(range(1, 1001, 10))
 
 
-def rows(path, tasks=None):
-    file = Path(path) / "results.jsonl"
-    if not file.exists():
-        return []
-    out = (json.loads(line) for line in file.open() if line.strip())
-    return [r for r in out if tasks is None or r["task"] in tasks]
-
-
 def run_dir(root, system, vehicle, sub100):
     if vehicle == "hmmwv":
         return root / "verti-100" / system
     return root / "vehicles" / (f"{system}-{vehicle}" + ("-sub100" if sub100 else ""))
-
-
-def pct(part, whole):
-    return f"{100.0 * part / whole:.1f}" if whole else "—"
 
 
 def table(root, system, sub100):
@@ -59,15 +48,11 @@ def table(root, system, sub100):
             lines.append(f"| `{name}` | {scale} | {what} | — | — | — | not run |")
             continue
         n = len(rs)
-        count = lambda o: sum(r["outcome"] == o for r in rs)  # noqa: E731
-        levels = []
-        for level in ["low", "mid", "high"]:
-            at = [r for r in rs if r["level"] == level]
-            levels.append(pct(sum(r["outcome"] == "success" for r in at), len(at)))
+        levels = success_by_level(rs)
         note = "" if n == expected else f" ({n} of {expected} tasks)"
         lines.append(
-            f"| `{name}` | {scale} | {what} | {pct(count('success'), n)}{note} | "
-            f"{pct(count('rollover'), n)} | {pct(count('stuck'), n)} | {' / '.join(levels)} |"
+            f"| `{name}` | {scale} | {what} | {share(rs, 'success')}{note} | "
+            f"{share(rs, 'rollover')} | {share(rs, 'stuck')} | {' / '.join(levels)} |"
         )
     return "\n".join(lines) + "\n"
 
