@@ -48,18 +48,30 @@ pub(crate) struct WheelModel {
     pub nominal_load: f64,
     /// Static compression of the spring with the vehicle at rest (see [`static_compressions`]).
     pub static_compression: f64,
-    /// On a solid axle: the wheel at the beam's other end and how its travel loads this one.
-    /// `spring` and `damper` above are then the self terms (see [`crate::spec::SolidAxleSpec`]).
-    pub solid: Option<SolidCoupling>,
+    /// On a solid axle or with an anti-roll bar: the wheel at the axle's other end and how its
+    /// travel loads this one. `spring` and `damper` above are then the self terms (see
+    /// [`crate::spec::SolidAxleSpec`] and [`crate::spec::AntiRollBarSpec`]).
+    pub coupling: Option<AxleCoupling>,
+    /// Beam axles: roll-centre height over track, h/t (left wheels only; 0 for none): the
+    /// locating links carry this share of the axle's lateral ground force as a vertical pair on
+    /// its two wheels (`suspension::roll_centre_links`).
+    pub link_share: f64,
+    /// Independent wheels: the contact patch's outward travel per unit of wheel travel, 2h/t
+    /// (signed: times +1 on the left, −1 on the right; 0 for none): the wheel's lateral ground
+    /// force jacks its travel by this share.
+    pub jacking: f64,
 }
 
-/// The coupling of a wheel to the other end of its solid axle: the suspension force on this
-/// wheel gains `spring_cross`·s_other + `damper_cross`·ṡ_other.
+/// The coupling of a wheel to the other end of its axle (a beam, an anti-roll bar): the
+/// suspension force on this wheel gains `spring_cross`·s_other + `damper_cross`·ṡ_other.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct SolidCoupling {
+pub(crate) struct AxleCoupling {
     pub partner: usize,
     pub spring_cross: f64,
     pub damper_cross: f64,
+    /// A beam with its own roll inertia: the (diagonal, off-diagonal) terms of the two travels'
+    /// mass matrix ([`crate::spec::BeamSpec::mass_matrix`]); the pair is then updated together.
+    pub beam: Option<(f64, f64)>,
 }
 
 /// Wheels that share one spin degree of freedom (a track's side, or a locked differential).
@@ -108,6 +120,10 @@ pub(crate) struct Model {
     /// [`LINKAGE_SAMPLES`] + 1 evenly spaced inputs from −1 to 1 (the closed form costs a
     /// dozen trigonometric calls, too many for every internal step).
     pub linkage_table: Option<Vec<[(f64, f64); 2]>>,
+    /// Whether any axle has a roll centre above (or below) the ground.
+    pub roll_centres: bool,
+    /// Whether any solid axle's beam has its own roll inertia (its wheels update as a pair).
+    pub beams: bool,
 }
 
 /// Intervals of [`Model::linkage_table`]: between samples the wheel angle changes by at most
@@ -178,19 +194,42 @@ impl Model {
                 let lat_mass = total_mass / spec.wheel_count() as f64;
                 let stop_damping = 2.0 * 0.5 * (ax.suspension.stop_stiffness * mu).sqrt();
                 let (rate_k, rate_c) = (ax.suspension.stiffness, ax.suspension.damping);
-                // a solid axle's wheels are numbered left (even), right (odd)
-                let (spring, damper, solid) = match &ax.solid_axle {
+                // an axle's wheels are numbered left (even), right (odd)
+                let (mut spring, damper, mut coupling) = match &ax.solid_axle {
                     None => (rate_k, rate_c, None),
                     Some(sa) => {
                         let (ks, kx) = SolidAxleSpec::coefficients(sa.spring_track, ax.track);
                         let (cs, cx) = SolidAxleSpec::coefficients(sa.damper_track, ax.track);
-                        let coupling = SolidCoupling {
+                        let coupling = AxleCoupling {
                             partner: w ^ 1,
                             spring_cross: rate_k * kx,
                             damper_cross: rate_c * cx,
+                            beam: sa.beam.map(|b| b.mass_matrix(mu, ax.track)),
                         };
+                        if let (Some(b), true) = (&sa.beam, side > 0.0) {
+                            // the beam rolls and yaws with the body as one bar, not as two
+                            // points at its ends
+                            let extra = b.roll_inertia - 0.25 * b.mass * ax.track * ax.track;
+                            inertia += Vec3::new(extra, 0.0, extra);
+                        }
                         (rate_k * ks, rate_c * cs, Some(coupling))
                     }
+                };
+                if let Some(bar) = &ax.anti_roll_bar {
+                    // rate·(s_own − s_other): a self term and a cross term of opposite sign
+                    spring += bar.rate;
+                    let c = coupling.get_or_insert(AxleCoupling {
+                        partner: w ^ 1,
+                        spring_cross: 0.0,
+                        damper_cross: 0.0,
+                        beam: None,
+                    });
+                    c.spring_cross -= bar.rate;
+                }
+                let (link_share, jacking) = match (ax.roll_centre_height, &ax.solid_axle) {
+                    (Some(h), Some(_)) if side > 0.0 => (h / ax.track, 0.0),
+                    (Some(h), None) => (0.0, side * 2.0 * h / ax.track),
+                    _ => (0.0, 0.0),
                 };
                 wheels.push(WheelModel {
                     attach,
@@ -214,7 +253,9 @@ impl Model {
                     slip_damping_lat: 0.6 * (k_lat * lat_mass).sqrt(),
                     nominal_load: per_wheel_load,
                     static_compression: comp[k],
-                    solid,
+                    coupling,
+                    link_share,
+                    jacking,
                 });
             }
         }
@@ -243,6 +284,12 @@ impl Model {
         let body_stiffness = 0.25 * total_mass * omega_body * omega_body;
         let body_damping = 2.0 * 0.5 * (body_stiffness * 0.25 * total_mass).sqrt();
         let reach = reach * 1.1 + 0.2 * scale;
+        let roll_centres = wheels
+            .iter()
+            .any(|w| w.link_share != 0.0 || w.jacking != 0.0);
+        let beams = wheels
+            .iter()
+            .any(|w| w.coupling.is_some_and(|c| c.beam.is_some()));
         let soil_floor = 2.0 * wheels.iter().map(|w| w.radius).fold(0.0, f64::max);
         let wheelbase = wheels
             .iter()
@@ -285,6 +332,8 @@ impl Model {
                     })
                     .collect()
             }),
+            roll_centres,
+            beams,
         }
     }
 }

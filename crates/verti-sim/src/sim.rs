@@ -151,9 +151,18 @@ impl Sim {
             let hub = state.position + r;
             e += 0.5 * m.unsprung_mass * v.norm_sq() + m.unsprung_mass * GRAVITY * hub.z;
             e += 0.5 * m.spring * w.compression * w.compression;
-            if let Some(sc) = &m.solid {
-                // half of the beam's cross term k_x·s_l·s_r; the partner adds the other half
-                e += 0.5 * sc.spring_cross * w.compression * state.wheels[sc.partner].compression;
+            if let Some(sc) = &m.coupling {
+                let other = &state.wheels[sc.partner];
+                // half of the axle's cross term k_x·s_l·s_r (beam, anti-roll bar); the partner adds
+                // the other half
+                e += 0.5 * sc.spring_cross * w.compression * other.compression;
+                if let (Some((_, cross)), true) = (sc.beam, m.y > 0.0) {
+                    // a beam rolling as one bar (I) rather than as two points at its ends:
+                    // ½·(I − M_b·t²/4)·Ω² = −½·cross·t²·Ω², Ω the beam's own roll rate
+                    let t = 2.0 * m.y;
+                    let roll = om.x + (w.compression_rate - other.compression_rate) / t;
+                    e -= 0.5 * cross * t * t * roll * roll;
+                }
             }
             if w.compression > m.bump {
                 e += 0.5 * m.stop * (w.compression - m.bump).powi(2);

@@ -82,6 +82,27 @@ pub struct AxleSpec {
     /// link-located solid axles) instead of sprung independently.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub solid_axle: Option<SolidAxleSpec>,
+    /// Height of the axle's geometric roll centre above the ground at the design position \[m\]
+    /// (from the linkage: where the line from a contact patch through its wheel's instant
+    /// centre crosses the centre line; for a beam axle, the height of its lateral location).
+    /// The links then carry the share F_y·h/t of the axle's lateral ground force F_y as a
+    /// vertical force pair on the two wheels, and the springs only the rest of the body's roll
+    /// moment. Absent: 0, the roll centre of a wheel sliding straight up and down (the ground).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub roll_centre_height: Option<f64>,
+    /// An anti-roll (stabiliser) bar between the two wheels of the axle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anti_roll_bar: Option<AntiRollBarSpec>,
+}
+
+/// An anti-roll bar: a torsion bar whose arms push each wheel of the axle towards its
+/// partner's travel, with force `rate`·(s_own − s_other). It leaves heave alone and adds
+/// `rate`·t² to the axle's roll stiffness (N m/rad, track t).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AntiRollBarSpec {
+    /// Force on each wheel per metre of travel difference between the two wheels \[N/m\].
+    pub rate: f64,
 }
 
 /// A solid (beam) axle: the left and right wheels are the ends of one rigid beam, and the
@@ -98,6 +119,34 @@ pub struct SolidAxleSpec {
     pub spring_track: f64,
     /// Lateral distance between the two dampers \[m\] (0 < d ≤ track).
     pub damper_track: f64,
+    /// The beam as a body of its own. Absent, its mass is split between its two ends (in
+    /// `wheel.unsprung_mass`), which gives it the roll inertia m·t²/4 of two point masses.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beam: Option<BeamSpec>,
+}
+
+/// The beam of a solid axle: its mass (the part of the two wheels' `unsprung_mass` that is the
+/// beam: tube, differential housing) and its roll inertia about its own centre. The two wheel
+/// travels then share one mass matrix: heave moves the whole unsprung mass, articulation (the
+/// beam rolling) moves the wheels' own masses plus I/(t/2)² of the beam.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeamSpec {
+    /// Mass of the beam \[kg\], at most the two wheels' unsprung masses together.
+    pub mass: f64,
+    /// Roll inertia of the beam about its centre \[kg m²\] (> 0).
+    pub roll_inertia: f64,
+}
+
+impl BeamSpec {
+    /// The 2 × 2 mass matrix of the axle's two wheel travels (diagonal, off-diagonal), with
+    /// each wheel's unsprung mass `m_u` (half the beam included) on track `t`: kinetic energy
+    /// ½·M_b·ż² + ½·I·θ̇² + ½·m_w·(ṡ_l² + ṡ_r²), z = (s_l + s_r)/2, θ = (s_l − s_r)/t,
+    /// m_w = m_u − M_b/2. Two point masses at the ends (I = M_b·t²/4) give (m_u, 0).
+    pub fn mass_matrix(&self, m_u: f64, t: f64) -> (f64, f64) {
+        let (quarter, rot) = (0.25 * self.mass, self.roll_inertia / (t * t));
+        (m_u - quarter + rot, quarter - rot)
+    }
 }
 
 impl SolidAxleSpec {
@@ -467,6 +516,37 @@ impl VehicleSpec {
                         ));
                     }
                 }
+                if let Some(beam) = &sa.beam {
+                    pos(&f("solid_axle.beam.mass"), beam.mass)?;
+                    pos(&f("solid_axle.beam.roll_inertia"), beam.roll_inertia)?;
+                    let ends = 2.0 * ax.wheel.unsprung_mass;
+                    if beam.mass > ends {
+                        return Err(bad(
+                            f("solid_axle.beam.mass"),
+                            format!(
+                                "{} is more than the two wheels' unsprung mass {ends}, which \
+                                 includes the beam",
+                                beam.mass
+                            ),
+                        ));
+                    }
+                }
+            }
+            if let Some(h) = ax.roll_centre_height {
+                finite(&f("roll_centre_height"), h)?;
+                if h.abs() > ax.track {
+                    return Err(bad(
+                        f("roll_centre_height"),
+                        format!(
+                            "{h} is further from the ground than the track {} (a roll centre \
+                             sits within a wheel diameter or so of the ground)",
+                            ax.track
+                        ),
+                    ));
+                }
+            }
+            if let Some(bar) = &ax.anti_roll_bar {
+                nonneg(&f("anti_roll_bar.rate"), bar.rate)?;
             }
             if i > 0 && ax.x >= self.axles[i - 1].x {
                 return Err(bad(

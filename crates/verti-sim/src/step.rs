@@ -83,6 +83,8 @@ impl Sim {
         let mut contacts = ContactInfo::default();
         let mut axis_loads = [AxisLoad::default(); MAX_WHEELS];
         let mut tyres = [TyreForces::default(); MAX_WHEELS];
+        // each wheel's lateral ground force, for the roll-centre links
+        let mut lateral = [0.0; MAX_WHEELS];
         let near = terrain.obstacles.near(st.position.x, st.position.y);
         let rigid = spec.tyre.model == TyreModel::Rigid;
         if rigid {
@@ -93,7 +95,7 @@ impl Sim {
                 near,
                 h,
             };
-            let scratch = (&mut axis_loads, &mut tyres);
+            let scratch = (&mut axis_loads, &mut tyres, &mut lateral);
             self.rigid_wheels(st, ctl, &stage, &mut loads, &mut contacts, scratch);
         } else {
             let mut spin_loads = SpinLoads::ZERO;
@@ -112,8 +114,10 @@ impl Sim {
                 let axle_moment = contact.soil_moment.dot(kin.axle);
                 spin_loads.add_wheel(m.group, tyre.roll_torque + axle_moment, &tyre.long);
                 let mut f_ext = gravity * m.unsprung_mass + contact.force;
+                lateral[w] = contact.force.dot(frame.ey);
                 if tyre.long.active {
                     f_ext += tyre.lat_force;
+                    lateral[w] += tyre.lat_force.dot(frame.ey);
                 }
                 let soil_off_axle = contact.soil_moment - kin.axle * axle_moment;
                 let moments = (soil_off_axle, tyre.contact_moment);
@@ -136,6 +140,7 @@ impl Sim {
                     continue;
                 }
                 let fx = long.force_at(st.group_spin[m.group]);
+                lateral[w] += (long.e_long * fx).dot(frame.ey);
                 let f_axis = loads.add_wheel_force(axis_loads[w].arm, frame.up, long.e_long * fx);
                 axis_loads[w].external += f_axis;
                 st.wheels[w].long_force = fx;
@@ -146,6 +151,11 @@ impl Sim {
             }
         }
 
+        // ---- links: the share of the lateral forces a roll centre off the ground carries ----
+        if model.roll_centres {
+            suspension::roll_centre_links(model, &lateral, frame.up, &mut axis_loads, &mut loads);
+        }
+
         // ---- chassis body contacts ----
         let mu_body = spec.chassis.friction;
         body_contacts(terrain, model, mu_body, st, near, &mut loads, &mut contacts);
@@ -154,8 +164,12 @@ impl Sim {
         // then the chassis itself ----
         let acc = integrate::accelerations(model, st, &loads);
         let v = st.velocity;
-        for ((ws, m), load) in st.wheels.iter_mut().zip(&model.wheels).zip(&axis_loads) {
-            suspension::update_wheel(ws, m, load, &acc, v, frame.omega, frame.up, h);
+        if model.beams {
+            update_wheels_with_beams(model, st, &axis_loads, &acc, &frame, h);
+        } else {
+            for ((ws, m), load) in st.wheels.iter_mut().zip(&model.wheels).zip(&axis_loads) {
+                suspension::update_wheel(ws, m, load, &acc, v, frame.omega, frame.up, h);
+            }
         }
         if !rigid {
             for (ws, tyre) in st.wheels.iter_mut().zip(&tyres) {
@@ -167,12 +181,64 @@ impl Sim {
     }
 }
 
+/// The implicit wheel updates when some solid axle's beam has its own roll inertia: its two
+/// wheels are updated together, every other wheel alone, in wheel order.
+fn update_wheels_with_beams(
+    model: &crate::model::Model,
+    st: &mut SimState,
+    axis_loads: &[AxisLoad; MAX_WHEELS],
+    acc: &integrate::Accelerations,
+    frame: &Frame,
+    h: f64,
+) {
+    let v = st.velocity;
+    let mut w = 0;
+    while w < model.wheels.len() {
+        let m = &model.wheels[w];
+        match m.coupling.and_then(|c| c.beam) {
+            // left wheels are even, their partner the next one
+            Some(masses) if w % 2 == 0 => {
+                let (left, right) = st.wheels.split_at_mut(w + 1);
+                let pair = [&mut left[w], &mut right[0]];
+                let models = [m, &model.wheels[w + 1]];
+                let loads = [&axis_loads[w], &axis_loads[w + 1]];
+                suspension::update_axle_pair(
+                    pair,
+                    models,
+                    loads,
+                    masses,
+                    acc,
+                    v,
+                    frame.omega,
+                    frame.up,
+                    h,
+                );
+                w += 2;
+            }
+            _ => {
+                let load = &axis_loads[w];
+                suspension::update_wheel(
+                    &mut st.wheels[w],
+                    m,
+                    load,
+                    acc,
+                    v,
+                    frame.omega,
+                    frame.up,
+                    h,
+                );
+                w += 1;
+            }
+        }
+    }
+}
+
 /// The chassis attitude at the start of an internal step: its axes and angular velocity in
 /// the world frame.
 pub(crate) struct Frame {
     q: Quat,
     ex: Vec3,
-    ey: Vec3,
+    pub ey: Vec3,
     pub up: Vec3,
     pub omega: Vec3,
 }

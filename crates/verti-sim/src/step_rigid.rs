@@ -23,10 +23,11 @@ use crate::suspension::{AxisLoad, spring_force};
 use verti_core::Vec3;
 
 /// The internal step's per-wheel arrays the rigid stage fills: the wheels' loads along their
-/// suspension axes, and scratch space for tyre forces.
+/// suspension axes, scratch space for tyre forces, and the lateral ground forces.
 pub(crate) type Scratch<'a> = (
     &'a mut [AxisLoad; MAX_WHEELS],
     &'a mut [TyreForces; MAX_WHEELS],
+    &'a mut [f64; MAX_WHEELS],
 );
 
 impl Sim {
@@ -41,7 +42,7 @@ impl Sim {
         stage: &RigidStage,
         loads: &mut Loads,
         contacts: &mut ContactInfo,
-        (axis_loads, tyres): Scratch,
+        (axis_loads, tyres, lateral): Scratch,
     ) {
         let (spec, model, terrain) = (&self.spec, &self.model, &self.terrain);
         let (frame, h) = (stage.frame, stage.h);
@@ -65,6 +66,7 @@ impl Sim {
             // the spin gets rolling resistance and the soil pressure moment about the axle
             let axle_moment = contact.soil_moment.dot(kin.axle);
             let mut f_ext = gravity * m.unsprung_mass + contact.force;
+            lateral[w] = contact.force.dot(frame.ey);
             // moments reaching the chassis through the bearing: the soil's pressure moment
             // off the axle and the rigid contacts' camber moment
             let mut off_axle = contact.soil_moment - kin.axle * axle_moment + rigid.moment;
@@ -81,6 +83,7 @@ impl Sim {
                 spin_loads.add_wheel(m.group, t.roll_torque + axle_moment, &t.long);
                 if t.long.active {
                     f_ext += t.lat_force;
+                    lateral[w] += t.lat_force.dot(frame.ey);
                 }
                 off_axle += t.contact_moment;
                 record_wheel(&mut st.wheels[w], contacts, &contact, &t);
@@ -112,6 +115,7 @@ impl Sim {
                 // axle drove the spin, the rest reaches the chassis through the bearing.
                 let r = &out[w];
                 let f = ct.e_long * r.fx + ct.e_lat * r.fy;
+                lateral[w] += f.dot(frame.ey);
                 axis_loads[w].external += loads.add_wheel_force(axis_loads[w].arm, frame.up, f);
                 let moment = ct.arm.cross(f);
                 loads.torque += moment - axles[w] * moment.dot(axles[w]);
@@ -127,6 +131,7 @@ impl Sim {
                 ws.long_force = if long.active {
                     let fx = long.force_at(spin);
                     let f = long.e_long * fx;
+                    lateral[w] += f.dot(frame.ey);
                     axis_loads[w].external += loads.add_wheel_force(axis_loads[w].arm, frame.up, f);
                     fx
                 } else {

@@ -96,7 +96,9 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
         chassis: "4-wheeled",
         suspension_families: &["double wishbone"],
         steering_families: &["pitman arm"],
-        suspension: "double wishbone (Chrono's reduced double-A-arm), modelled as independent wheels",
+        suspension: "double wishbone (Chrono's reduced double-A-arm), modelled as independent wheels \
+                     sliding straight up and down (roll centre on the ground; Chrono's linkage puts \
+                     it 0.354 m front, 0.407 m rear above the ground: not adopted, see the engine docs)",
         steering: "Pitman arm, modelled as Ackermann geometry up to the 30.23° road-wheel angle",
         source: "Chrono 9.0.1 HMMWV_Reduced as Verti-Bench uses it (physics_spec §3.1)",
     };
@@ -104,7 +106,9 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
         chassis,
         suspension_families: &["multilink"],
         steering_families: &["bellcrank/rotary arm"],
-        suspension: "solid three-link (multi-link beam) axles after Chrono's MAN Kat1, modelled as independent wheels",
+        suspension: "solid three-link axles after Chrono's MAN Kat1: each axle one beam (springs \
+                     1.18 m apart in front, 1.31 m at the rear), roll centres at the triangle link's \
+                     apex, 0.89 m above the ground",
         steering: "rotary arm (bellcrank), modelled as Ackermann geometry",
         source: "Chrono MAN Kat1 chassis and layout (physics_spec §3.3); springs, tyres, engine chosen",
     };
@@ -114,7 +118,8 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             chassis: "4-wheeled, 1/6 scale",
             suspension_families: &["double wishbone"],
             steering_families: &["pitman arm"],
-            suspension: "double wishbone, modelled as independent wheels",
+            suspension: "double wishbone: independent wheels with the linkage's roll centre, \
+                         0.029 m above the ground (camber change not modelled)",
             steering: "Pitman arm and idler: each wheel's angle from the linkage's geometry",
             source: "Chrono ARTcar (physics_spec §3.2); COM, wheel rate, motor voltage chosen",
         },
@@ -122,7 +127,8 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             chassis: "4-wheeled, 1/10 scale",
             suspension_families: &["multilink"],
             steering_families: &["bellcrank/rotary arm"],
-            suspension: "solid three-link (multi-link beam) axles, modelled as independent wheels",
+            suspension: "solid three-link (multi-link beam) axles, modelled as independent wheels \
+                         (no public suspension geometry of this vehicle)",
             steering: "rotary arm / bellcrank, modelled as Ackermann geometry",
             source: "Verti-4-Wheeler C++ model in the Verti-Bench fork (verti_bench_spec §4.3); springs, motor, inertia chosen",
         },
@@ -143,7 +149,8 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension_families: &["toe-bar leaf-spring"],
             steering_families: &["toe-bar", "bellcrank/rotary arm"],
             suspension: "leaf-spring solid axles (toe-bar axle in front), modelled as solid axles: \
-                         wheels coupled through springs 1.028 m and dampers 0.882 m apart",
+                         wheels coupled through springs 1.028 m and dampers 0.882 m apart, roll \
+                         centres at the axle tube's guide, 0.372 m above the ground",
             steering: "toe-bar axle steered by a drag link from a rotary Pitman arm: each wheel's \
                        angle from the linkage's geometry (left and right locks differ)",
             source: "Chrono UAZ469 / UAZBUS (data/vehicle/uaz, src/chrono_models/vehicle/uaz)",
@@ -152,7 +159,8 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             chassis: "4-wheeled",
             suspension_families: &["single wishbone"],
             steering_families: &["rack-and-pinion"],
-            suspension: "single wishbone in front (wheel rate from the strut's motion ratio 0.62), \
+            suspension: "single wishbone (swing arm) in front: wheel rate from the strut's motion \
+                         ratio 0.62, roll centre at the arm's pivot line, 0.342 m above the ground; \
                          rigid rear axle (a spring as stiff as the step allows)",
             steering: "rack and pinion: each wheel's angle from the linkage's geometry (parallel \
                        steer)",
@@ -163,8 +171,9 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension_families: &["double wishbone", "multilink"],
             steering_families: &["rack-and-pinion"],
             suspension: "double wishbone in front, multilink rear (upper A-arm, lateral, trailing \
-                         and toe links), modelled as independent wheels at their wheel rates (coil \
-                         motion ratios 0.519 front, 0.612 rear, by virtual work)",
+                         and toe links): independent wheels at their wheel rates (coil motion ratios \
+                         0.519 front, 0.612 rear, by virtual work) with the linkages' roll centres, \
+                         0.164 m front and 0.043 m rear above the ground (camber change not modelled)",
             steering: "rack and pinion: each wheel's angle from the linkage's geometry \
                        (anti-Ackermann)",
             source: "Chrono Sedan, C++ model (src/chrono_models/vehicle/sedan)",
@@ -271,6 +280,27 @@ impl VehicleSpec {
                     sa.spring_track,
                     sa.damper_track,
                     100.0 * (sa.spring_track / a.track).powi(2)
+                );
+                if let Some(b) = &sa.beam {
+                    let _ = writeln!(
+                        s,
+                        "          beam {:.1} kg, roll inertia {:.2} kg m² (its wheels' travels share one mass matrix)",
+                        b.mass, b.roll_inertia
+                    );
+                }
+            }
+            if let Some(h) = a.roll_centre_height {
+                let _ = writeln!(
+                    s,
+                    "          roll centre {h:.3} m above the ground (the links carry F_y·{h:.3} m of the roll moment of the axle's lateral force F_y)"
+                );
+            }
+            if let Some(bar) = &a.anti_roll_bar {
+                let _ = writeln!(
+                    s,
+                    "          anti-roll bar {:.0} N/m per metre of travel difference (+{:.0} N m/rad of roll stiffness)",
+                    bar.rate,
+                    bar.rate * a.track * a.track
                 );
             }
         }
