@@ -1,5 +1,5 @@
-//! Steering linkages: the two road-wheel angles a rack and pinion, a Pitman arm or a toe bar
-//! gives for a steering input, from the linkage's points in the ground plane.
+//! Steering linkages: the two road-wheel angles a rack and pinion, a Pitman arm, a toe bar or a
+//! bellcrank gives for a steering input, from the linkage's points in the ground plane.
 //!
 //! Each side is a four-bar "crank": the knuckle turns about its kingpin K, its steering arm
 //! ends at T (the tie rod's outer joint), and a tie rod of fixed length joins T to a point C on
@@ -8,7 +8,9 @@
 //! rotation follows in closed form: with D = C − K, ρ = |D|, arm length r and rod length l,
 //! the arm's new direction is atan2(D) ± acos((r² + ρ² − l²) / (2 r ρ)), the branch the one
 //! the linkage is assembled in. A toe bar chains two cranks: the drag link turns the left
-//! knuckle, and the toe bar between the steering arms turns the right one. Left and right
+//! knuckle, and the toe bar between the steering arms turns the right one. A bellcrank chains
+//! three: the rotary arm moves the drag link, which turns the bellcrank (a crank about its
+//! pivot), which moves both tie rods' inner joints. Left and right
 //! sides are mirror images (a toe bar's drive is not, so its locks differ), and the two wheels turn by
 //! different angles: the linkage's Ackermann error, which ideal Ackermann geometry
 //! (cot δ_o − cot δ_i = d / L) would not have. Kingpin inclination, caster and the suspension's
@@ -32,6 +34,11 @@ pub enum LinkageKind {
     /// across the vehicle and turns by `arm_max_angle_deg` at full input, moving the drag
     /// link's end forward for a left turn. Left and right locks differ.
     ToeBar,
+    /// A rotary arm turning about a vertical axis at `arm_pivot` by `arm_max_angle_deg` at
+    /// full input (clockwise seen from above for a left turn) pulls a drag link that turns a
+    /// bellcrank about `drag_kingpin` on the axle; the bellcrank carries both tie rods' inner
+    /// joints. Left and right locks differ (the drag link's angle changes as it swings).
+    Bellcrank,
 }
 
 /// A steering linkage in the ground plane, by its points on the left side (the right side is
@@ -50,7 +57,9 @@ pub struct LinkageSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tie_rod_inner: Option<[f64; 2]>,
     /// Toe bar: the drag link's joint on the left knuckle, its other end on the rotary arm
-    /// (wheels straight), and the kingpin at the drag link's height.
+    /// (wheels straight), and the kingpin at the drag link's height. Bellcrank: the drag
+    /// link's joint on the bellcrank, its other end on the rotary arm, and the bellcrank's
+    /// pivot (these two may lie anywhere, not only on the left).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub drag_arm: Option<[f64; 2]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -65,6 +74,10 @@ pub struct LinkageSpec {
     pub arm_length: f64,
     #[serde(default)]
     pub arm_max_angle_deg: f64,
+    /// Bellcrank: the rotary arm's pivot (its vertical axis); its length is the distance to
+    /// `drag_link_end`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arm_pivot: Option<[f64; 2]>,
 }
 
 /// Planar point \[m\]: x forward, y left.
@@ -107,7 +120,7 @@ fn inner_joint_shift(l: &LinkageSpec, u: f64) -> P2 {
                 -l.arm_length * libm::sin(theta),
             ]
         }
-        LinkageKind::ToeBar => [0.0, 0.0],
+        LinkageKind::ToeBar | LinkageKind::Bellcrank => [0.0, 0.0],
     }
 }
 
@@ -135,6 +148,32 @@ pub fn wheel_angles(l: &LinkageSpec, u: f64) -> Option<(f64, f64)> {
             mirror(l.steering_arm),
             l.steering_arm,
             toe_left,
+        )?;
+        return Some((left, right));
+    }
+    if l.kind == LinkageKind::Bellcrank {
+        // the rotary arm turns its end about its vertical axis; the drag link, a crank of its
+        // own, turns the bellcrank; the bellcrank carries both tie rods' inner joints
+        let (crank_arm, drag_end, pivot) = (l.drag_arm?, l.drag_link_end?, l.drag_kingpin?);
+        let arm_end = rotate(
+            drag_end,
+            l.arm_pivot?,
+            -u * l.arm_max_angle_deg.to_radians(),
+        );
+        let crank = knuckle_rotation(pivot, crank_arm, drag_end, arm_end)?;
+        let inner_left = l.tie_rod_inner?;
+        let inner_right = mirror(inner_left);
+        let left = knuckle_rotation(
+            l.kingpin,
+            l.steering_arm,
+            inner_left,
+            rotate(inner_left, pivot, crank),
+        )?;
+        let right = knuckle_rotation(
+            mirror(l.kingpin),
+            mirror(l.steering_arm),
+            inner_right,
+            rotate(inner_right, pivot, crank),
         )?;
         return Some((left, right));
     }

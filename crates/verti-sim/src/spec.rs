@@ -260,7 +260,8 @@ pub enum SteeringKind {
     /// (tracked vehicles; see `drivetrain::skid_speed_ratio`).
     Skid,
     /// The steered axle's wheels turn through a steering linkage (`linkage`): a rack and
-    /// pinion, a Pitman arm or a toe bar, each wheel by the angle the linkage gives it.
+    /// pinion, a Pitman arm, a toe bar or a bellcrank, each wheel by the angle the linkage
+    /// gives it.
     Linkage,
 }
 
@@ -604,6 +605,18 @@ impl VehicleSpec {
             let needed: &[&str] = match l.kind {
                 LinkageKind::RackAndPinion | LinkageKind::PitmanArm => &["tie_rod_inner"],
                 LinkageKind::ToeBar => &["drag_arm", "drag_link_end", "drag_kingpin"],
+                LinkageKind::Bellcrank => &[
+                    "tie_rod_inner",
+                    "drag_arm",
+                    "drag_link_end",
+                    "drag_kingpin",
+                    "arm_pivot",
+                ],
+            };
+            // points a mirror image is taken of lie on the left; a bellcrank's drive may not
+            let anywhere: &[&str] = match l.kind {
+                LinkageKind::Bellcrank => &["drag_link_end", "drag_kingpin", "arm_pivot"],
+                _ => &[],
             };
             let points = [
                 ("kingpin", Some(l.kingpin)),
@@ -612,6 +625,7 @@ impl VehicleSpec {
                 ("drag_arm", l.drag_arm),
                 ("drag_link_end", l.drag_link_end),
                 ("drag_kingpin", l.drag_kingpin),
+                ("arm_pivot", l.arm_pivot),
             ];
             for (name, p) in points {
                 match p {
@@ -630,7 +644,13 @@ impl VehicleSpec {
                             format!("not used by a {:?} linkage", l.kind),
                         ));
                     }
-                    Some(p) if !(p[0].is_finite() && p[1].is_finite() && p[1] > 0.0) => {
+                    Some(p) if !(p[0].is_finite() && p[1].is_finite()) => {
+                        return Err(bad(
+                            format!("steering.linkage.{name}"),
+                            format!("{p:?} must be a finite point"),
+                        ));
+                    }
+                    Some(p) if p[1] <= 0.0 && !anywhere.contains(&name) => {
                         return Err(bad(
                             format!("steering.linkage.{name}"),
                             format!("{p:?} must be a finite point on the left side (y > 0)"),
@@ -641,6 +661,14 @@ impl VehicleSpec {
             }
             match l.kind {
                 LinkageKind::RackAndPinion => pos("steering.linkage.rack_travel", l.rack_travel)?,
+                LinkageKind::Bellcrank => {
+                    if !(l.arm_max_angle_deg > 0.0 && l.arm_max_angle_deg < 90.0) {
+                        return Err(bad(
+                            "steering.linkage.arm_max_angle_deg".into(),
+                            format!("{} must be in (0, 90)", l.arm_max_angle_deg),
+                        ));
+                    }
+                }
                 LinkageKind::PitmanArm | LinkageKind::ToeBar => {
                     pos("steering.linkage.arm_length", l.arm_length)?;
                     if !(l.arm_max_angle_deg > 0.0 && l.arm_max_angle_deg < 90.0) {

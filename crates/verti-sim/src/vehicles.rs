@@ -102,14 +102,14 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
         steering: "Pitman arm, modelled as Ackermann geometry up to the 30.23° road-wheel angle",
         source: "Chrono 9.0.1 HMMWV_Reduced as Verti-Bench uses it (physics_spec §3.1)",
     };
-    let man = |chassis| Mechanisms {
+    let man = |chassis, steering| Mechanisms {
         chassis,
         suspension_families: &["multilink"],
         steering_families: &["bellcrank/rotary arm"],
         suspension: "solid three-link axles after Chrono's MAN Kat1: each axle one beam (springs \
                      1.18 m apart in front, 1.31 m at the rear), roll centres at the triangle link's \
                      apex, 0.89 m above the ground",
-        steering: "rotary arm (bellcrank), modelled as Ackermann geometry",
+        steering,
         source: "Chrono MAN Kat1 chassis and layout (physics_spec §3.3); springs, tyres, engine chosen",
     };
     Some(match name {
@@ -132,8 +132,16 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             steering: "rotary arm / bellcrank, modelled as Ackermann geometry",
             source: "Verti-4-Wheeler C++ model in the Verti-Bench fork (verti_bench_spec §4.3); springs, motor, inertia chosen",
         },
-        "truck6" => man("6-wheeled"),
-        "truck8" => man("8-wheeled"),
+        "truck6" => man(
+            "6-wheeled",
+            "rotary arm and bellcrank (Chrono's MAN 7t): each wheel's angle from the linkage's \
+             geometry (left and right locks differ)",
+        ),
+        "truck8" => man(
+            "8-wheeled",
+            "rotary arms and bellcranks on two steered axles, modelled as Ackermann geometry (a \
+             linkage here steers one axle)",
+        ),
         "m113" => Mechanisms {
             chassis: "2-tracked",
             suspension_families: &["tensioned"],
@@ -318,6 +326,7 @@ impl VehicleSpec {
                         crate::spec::LinkageKind::RackAndPinion => "rack and pinion",
                         crate::spec::LinkageKind::PitmanArm => "Pitman arm",
                         crate::spec::LinkageKind::ToeBar => "toe bar",
+                        crate::spec::LinkageKind::Bellcrank => "rotary arm and bellcrank",
                     };
                     let _ = write!(s, "  steering         {mechanism} linkage; at full lock");
                     for (turn, u) in [("left", 1.0), ("right", -1.0)] {

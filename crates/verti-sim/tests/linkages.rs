@@ -1,6 +1,6 @@
-//! Steering linkages (rack and pinion, Pitman arm, toe bar) against their derivation: the
-//! road-wheel angles of the Gator's and the Sedan's racks, the ARTcar's Pitman arm and the
-//! UAZ's toe bar, from Chrono's
+//! Steering linkages (rack and pinion, Pitman arm, toe bar, bellcrank) against their
+//! derivation: the road-wheel angles of the Gator's and the Sedan's racks, the ARTcar's Pitman
+//! arm, the UAZ's toe bar and the truck6's rotary arm and bellcrank, from Chrono's
 //! hardpoints projected on the ground plane, worked out independently of this code (a Python
 //! derivation of the same four-bar closed form from the hardpoints: left and right angles for
 //! inputs 0.25 to 1, to 0.01°), and the limits that follow from the geometry by hand.
@@ -111,6 +111,84 @@ fn artcar_pitman_arm() {
 /// With the arms straight back and the tie rods across (parallel steer) both wheels turn alike
 /// while the rods' angularity is small, as sin δ = travel / arm by hand; and the bicycle angle
 /// of two different wheel angles lies between them.
+// The truck6's rotary arm and bellcrank (Chrono's MAN 7t): the derivation's angles, and the
+// same chain solved another way, as three sets of distance constraints by bisection (the drag
+// link's, then each tie rod's length kept), to 1e-9 rad.
+#[test]
+fn truck6_rotary_arm_and_bellcrank() {
+    check(
+        "truck6",
+        &[
+            (0.25, 9.65, 9.15),
+            (0.5, 20.41, 18.20),
+            (0.75, 32.42, 26.79),
+            (1.0, 46.34, 34.38),
+            (-0.25, -8.62, -9.07),
+            (-0.5, -16.30, -18.03),
+            (-0.75, -23.10, -26.97),
+            (-1.0, -29.10, -36.16),
+        ],
+        false,
+    );
+    let l = linkage("truck6");
+    let rot = |p: [f64; 2], c: [f64; 2], a: f64| {
+        let (s, co) = a.sin_cos();
+        let (x, y) = (p[0] - c[0], p[1] - c[1]);
+        [c[0] + co * x - s * y, c[1] + s * x + co * y]
+    };
+    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    // the angle in [-1.2, 1.2] rad at which `gap` (a length minus its rest value, monotonic
+    // over the linkage's range) vanishes
+    let solve = |gap: &dyn Fn(f64) -> f64| {
+        let (mut lo, mut hi) = (-1.2, 1.2);
+        let rising = gap(hi) > gap(lo);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if (gap(mid) > 0.0) == rising {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    };
+    let (pivot, crank0, end0) = (
+        l.drag_kingpin.unwrap(),
+        l.drag_arm.unwrap(),
+        l.drag_link_end.unwrap(),
+    );
+    let inner0 = l.tie_rod_inner.unwrap();
+    let mirror = |p: [f64; 2]| [p[0], -p[1]];
+    for k in -4..=4 {
+        let u = f64::from(k) / 4.0;
+        let end = rot(
+            end0,
+            l.arm_pivot.unwrap(),
+            -u * l.arm_max_angle_deg.to_radians(),
+        );
+        let drag = dist(end0, crank0);
+        let crank = solve(&|phi| dist(end, rot(crank0, pivot, phi)) - drag);
+        let side = |kingpin: [f64; 2], arm: [f64; 2], inner: [f64; 2]| {
+            let moved = rot(inner, pivot, crank);
+            let rod = dist(arm, inner);
+            solve(&|delta| dist(rot(arm, kingpin, delta), moved) - rod)
+        };
+        let left = side(l.kingpin, l.steering_arm, inner0);
+        let right = side(mirror(l.kingpin), mirror(l.steering_arm), mirror(inner0));
+        let (wl, wr) = wheel_angles(&l, u).unwrap();
+        assert!(
+            (wl - left).abs() < 1e-9 && (wr - right).abs() < 1e-9,
+            "input {u}: {wl} {wr} vs {left} {right}"
+        );
+    }
+    // the locks differ: the bicycle angle is 39.6° turning left, 32.3° turning right, and the
+    // vehicle file's 35.96° is their mean
+    let (l1, r1) = wheel_angles(&l, 1.0).unwrap();
+    let (l2, r2) = wheel_angles(&l, -1.0).unwrap();
+    assert!((bicycle_angle(l1, r1).to_degrees() - 39.62).abs() < 0.01);
+    assert!((-bicycle_angle(l2, r2).to_degrees() - 32.29).abs() < 0.01);
+}
+
 #[test]
 fn parallel_steer_by_hand() {
     let arm = 0.15f64;
@@ -125,6 +203,7 @@ fn parallel_steer_by_hand() {
         rack_travel: 0.05,
         arm_length: 0.0,
         arm_max_angle_deg: 0.0,
+        arm_pivot: None,
     };
     let (a, b) = wheel_angles(&l, 0.2).unwrap();
     let hand = (0.2f64 * 0.05 / arm).asin();
