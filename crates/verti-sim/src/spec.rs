@@ -661,23 +661,20 @@ impl VehicleSpec {
             }
             match l.kind {
                 LinkageKind::RackAndPinion => pos("steering.linkage.rack_travel", l.rack_travel)?,
-                LinkageKind::Bellcrank => {
-                    if !(l.arm_max_angle_deg > 0.0 && l.arm_max_angle_deg < 90.0) {
-                        return Err(bad(
-                            "steering.linkage.arm_max_angle_deg".into(),
-                            format!("{} must be in (0, 90)", l.arm_max_angle_deg),
-                        ));
-                    }
-                }
                 LinkageKind::PitmanArm | LinkageKind::ToeBar => {
                     pos("steering.linkage.arm_length", l.arm_length)?;
-                    if !(l.arm_max_angle_deg > 0.0 && l.arm_max_angle_deg < 90.0) {
-                        return Err(bad(
-                            "steering.linkage.arm_max_angle_deg".into(),
-                            format!("{} must be in (0, 90)", l.arm_max_angle_deg),
-                        ));
-                    }
                 }
+                // its arm's length is the distance from `arm_pivot` to `drag_link_end`
+                LinkageKind::Bellcrank => {}
+            }
+            // every kind but the rack turns an arm
+            if l.kind != LinkageKind::RackAndPinion
+                && !(l.arm_max_angle_deg > 0.0 && l.arm_max_angle_deg < 90.0)
+            {
+                return Err(bad(
+                    "steering.linkage.arm_max_angle_deg".into(),
+                    format!("{} must be in (0, 90)", l.arm_max_angle_deg),
+                ));
             }
             crate::linkage::check(l).map_err(|e| bad("steering.linkage".into(), e))?;
             if self.axles.iter().filter(|a| a.steered).count() != 1 {

@@ -27,7 +27,7 @@ use crate::drivetrain::{self, SpinLoads};
 use crate::error::SimError;
 use crate::friction::{self, TyreForces};
 use crate::integrate::{self, Loads};
-use crate::model::{GRAVITY, WheelModel};
+use crate::model::{AxleCoupling, GRAVITY, Model, WheelModel};
 use crate::sim::Sim;
 use crate::spec::{MAX_WHEELS, TyreModel};
 use crate::state::{ContactInfo, Controls, SimState, WheelState};
@@ -184,7 +184,7 @@ impl Sim {
 /// The implicit wheel updates when some solid axle's beam has its own roll inertia: its two
 /// wheels are updated together, every other wheel alone, in wheel order.
 fn update_wheels_with_beams(
-    model: &crate::model::Model,
+    model: &Model,
     st: &mut SimState,
     axis_loads: &[AxisLoad; MAX_WHEELS],
     acc: &integrate::Accelerations,
@@ -195,16 +195,19 @@ fn update_wheels_with_beams(
     let mut w = 0;
     while w < model.wheels.len() {
         let m = &model.wheels[w];
-        match m.coupling.and_then(|c| c.beam) {
+        match m.coupling {
             // left wheels are even, their partner the next one
-            Some(masses) if w % 2 == 0 => {
+            Some(
+                coupling @ AxleCoupling {
+                    beam: Some(masses), ..
+                },
+            ) if w % 2 == 0 => {
                 let (left, right) = st.wheels.split_at_mut(w + 1);
                 let pair = [&mut left[w], &mut right[0]];
-                let models = [m, &model.wheels[w + 1]];
                 let loads = [&axis_loads[w], &axis_loads[w + 1]];
                 suspension::update_axle_pair(
                     pair,
-                    models,
+                    &coupling,
                     loads,
                     masses,
                     acc,

@@ -3,7 +3,7 @@
 
 use crate::contact::WheelContact;
 use crate::integrate::{Accelerations, Loads};
-use crate::model::{Model, WheelModel};
+use crate::model::{AxleCoupling, Model, WheelModel};
 use crate::spec::MAX_WHEELS;
 use crate::state::WheelState;
 use verti_core::Vec3;
@@ -117,6 +117,20 @@ impl AxisLoad {
     }
 }
 
+/// How a wheel's attachment at `arm` (from the centre of mass) moves this step: its
+/// acceleration with the chassis', and its velocity after the step.
+#[inline(always)]
+fn attachment(
+    arm: Vec3,
+    acc: &Accelerations,
+    chassis_velocity: Vec3,
+    omega_w: Vec3,
+    h: f64,
+) -> (Vec3, Vec3) {
+    let a = acc.linear + acc.angular.cross(arm) + omega_w.cross(omega_w.cross(arm));
+    (a, chassis_velocity + omega_w.cross(arm) + a * h)
+}
+
 /// Staggered implicit update of one wheel's compression. The chassis has just been advanced
 /// explicitly (`acc`); the wheel's absolute velocity along the suspension axis is then solved
 /// implicitly against its spring, damper and contact stiffness, with the contact acting on the
@@ -134,10 +148,8 @@ pub(crate) fn update_wheel(
     up: Vec3,
     h: f64,
 ) {
-    let r = load.arm;
-    let a_attach_vec = acc.linear + acc.angular.cross(r) + omega_w.cross(omega_w.cross(r));
+    let (a_attach_vec, v_attach_new) = attachment(load.arm, acc, chassis_velocity, omega_w, h);
     let a_attach = a_attach_vec.dot(up);
-    let v_attach_new = chassis_velocity + omega_w.cross(r) + a_attach_vec * h;
     let f0 = load.external
         - load.spring
         - m.unsprung_mass * a_attach
@@ -158,7 +170,7 @@ pub(crate) fn update_wheel(
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn update_axle_pair(
     pair: [&mut WheelState; 2],
-    models: [&WheelModel; 2],
+    coupling: &AxleCoupling,
     loads: [&AxisLoad; 2],
     (diagonal, cross): (f64, f64),
     acc: &Accelerations,
@@ -170,10 +182,8 @@ pub(crate) fn update_axle_pair(
     let mut a_attach = [0.0; 2];
     let mut f0 = [0.0; 2];
     for i in 0..2 {
-        let r = loads[i].arm;
-        let a_vec = acc.linear + acc.angular.cross(r) + omega_w.cross(omega_w.cross(r));
+        let (a_vec, v_attach_new) = attachment(loads[i].arm, acc, chassis_velocity, omega_w, h);
         a_attach[i] = a_vec.dot(up);
-        let v_attach_new = chassis_velocity + omega_w.cross(r) + a_vec * h;
         f0[i] = loads[i].external
             - loads[i].spring
             - h * loads[i].k_vec.dot(v_attach_new)
@@ -182,9 +192,7 @@ pub(crate) fn update_axle_pair(
     // the inertia of the attachments' motion, through the full mass matrix
     f0[0] -= diagonal * a_attach[0] + cross * a_attach[1];
     f0[1] -= cross * a_attach[0] + diagonal * a_attach[1];
-    let (k_x, c_x) = models[0]
-        .coupling
-        .map_or((0.0, 0.0), |c| (c.spring_cross, c.damper_cross));
+    let (k_x, c_x) = (coupling.spring_cross, coupling.damper_cross);
     // (M + h·C) and the system matrix A = M + h·C + h²·K
     let mc = [
         [diagonal + h * loads[0].damping, cross + h * c_x],
@@ -335,14 +343,14 @@ mod tests {
                         c_vec: Vec3::ZERO,
                     };
                 }
-                let masses = model.wheels[0].coupling.unwrap().beam.unwrap();
+                let coupling = model.wheels[0].coupling.unwrap();
+                let masses = coupling.beam.unwrap();
                 let (left, right) = wheels.split_at_mut(1);
                 let pair = [&mut left[0], &mut right[0]];
-                let models = [&model.wheels[0], &model.wheels[1]];
                 let zero = Vec3::ZERO;
                 update_axle_pair(
                     pair,
-                    models,
+                    &coupling,
                     [&loads[0], &loads[1]],
                     masses,
                     &still,
