@@ -74,8 +74,40 @@ pub(crate) fn wheel_steer(spec: &VehicleSpec, model: &Model, steer: f64) -> Whee
 /// and ρ = (1 − κ B/2) / (1 + κ B/2) (ρ < 0 counter-rotates the inner track when κ B/2 > 1).
 #[inline]
 pub fn skid_speed_ratio(spec: &VehicleSpec, steer: f64) -> f64 {
-    let half_gauge = 0.5 * spec.axles.first().map_or(0.0, |a| a.track);
-    let kb = libm::tan(steer.abs()) / spec.wheelbase() * half_gauge;
+    speed_ratio_for(spec, libm::tan(steer.abs()) / spec.wheelbase())
+}
+
+/// Gain of the steer unit's yaw-rate feedback on the path curvature's error (see
+/// [`steered_curvature`]).
+const YAW_FEEDBACK_GAIN: f64 = 3.0;
+/// Forward speed \[m/s at full scale\] from which the feedback acts fully; it fades in
+/// linearly from a third of it (at a standstill the measured curvature r/v means nothing).
+const YAW_FEEDBACK_SPEED: f64 = 1.0;
+
+/// The path curvature the steer unit of a skid-steered vehicle realises this step: the
+/// equivalent bicycle's κ = tan(steer) / L, corrected in proportion to how far the measured
+/// curvature (yaw rate over forward speed) falls short of it. A skid-steered vehicle slides
+/// sideways at both ends of its tracks as it turns and turns 30–40 % wider than its tracks'
+/// speed ratio says (`tests/tracked.rs`); steered by wire with a yaw-rate sensor, as a
+/// hydrostatic steer unit can be, it follows the path the input names, which is what every
+/// system, planning with a bicycle, asks of it.
+#[inline]
+fn steered_curvature(spec: &VehicleSpec, st: &SimState) -> f64 {
+    let kappa = libm::tan(st.steer) / spec.wheelbase();
+    let v = st.velocity_body().x;
+    let v_full = YAW_FEEDBACK_SPEED * spec.scale.sqrt();
+    let weight = ((v.abs() - v_full / 3.0) / (v_full * 2.0 / 3.0)).clamp(0.0, 1.0);
+    if weight == 0.0 {
+        return kappa;
+    }
+    let measured = st.omega.z / v;
+    kappa + weight * YAW_FEEDBACK_GAIN * (kappa - measured)
+}
+
+/// [`skid_speed_ratio`] for a path curvature's magnitude `kappa`.
+#[inline]
+fn speed_ratio_for(spec: &VehicleSpec, kappa: f64) -> f64 {
+    let kb = kappa * 0.5 * spec.axles.first().map_or(0.0, |a| a.track);
     (1.0 - kb) / (1.0 + kb)
 }
 
@@ -309,13 +341,14 @@ fn hold_speed_ratio(
     if held[left] || held[right] {
         return;
     }
-    // positive steering turns left: the left side is the inner one
-    let (inner, outer) = if st.steer >= 0.0 {
+    let kappa = steered_curvature(spec, st);
+    // positive curvature turns left: the left side is the inner one
+    let (inner, outer) = if kappa >= 0.0 {
         (left, right)
     } else {
         (right, left)
     };
-    let rho = skid_speed_ratio(spec, st.steer);
+    let rho = speed_ratio_for(spec, kappa.abs());
     let (f_in, f_out) = (factor[inner], factor[outer]);
     let n_in = model.groups[inner].wheels.len() as f64;
     let capacity = spec.steering.skid_brake_torque * n_in;

@@ -54,6 +54,7 @@ mod step_rigid;
 mod suspension;
 mod terrain;
 pub mod testing;
+mod track_runs;
 mod tyre;
 pub mod vehicles;
 

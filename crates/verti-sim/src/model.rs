@@ -13,6 +13,7 @@
 //! chassis z axis, which is how vehicles are described here.
 
 use crate::spec::{Differential, SolidAxleSpec, VehicleSpec};
+use crate::track_runs::TrackRuns;
 use verti_core::Vec3;
 
 /// Standard gravity \[m/s²\] (Chrono: 9.81 along −Z).
@@ -124,6 +125,8 @@ pub(crate) struct Model {
     pub roll_centres: bool,
     /// Whether any solid axle's beam has its own roll inertia (its wheels update as a pair).
     pub beams: bool,
+    /// A tracked vehicle's raised track ends, when its file gives them.
+    pub track_runs: Option<TrackRuns>,
 }
 
 /// Intervals of [`Model::linkage_table`]: between samples the wheel angle changes by at most
@@ -283,6 +286,14 @@ impl Model {
         let omega_body = 0.15 / h;
         let body_stiffness = 0.25 * total_mass * omega_body * omega_body;
         let body_damping = 2.0 * 0.5 * (body_stiffness * 0.25 * total_mass).sqrt();
+        if let Some(runs) = spec.track.and_then(|t| t.runs) {
+            // the rollers the track wraps reach beyond the hull's box
+            let ax = &spec.axles[0];
+            let y = 0.5 * ax.track + 0.5 * ax.wheel.width;
+            for r in [runs.sprocket, runs.idler] {
+                reach = reach.max((Vec3::new(r.x, y, r.z) - com).norm() + r.radius);
+            }
+        }
         let reach = reach * 1.1 + 0.2 * scale;
         let roll_centres = wheels
             .iter()
@@ -291,6 +302,20 @@ impl Model {
             .iter()
             .any(|w| w.coupling.is_some_and(|c| c.beam.is_some()));
         let soil_floor = 2.0 * wheels.iter().map(|w| w.radius).fold(0.0, f64::max);
+        let wheel_xy: Vec<(f64, f64)> = (0..wheels.len())
+            .map(|w| {
+                let side = if w % 2 == 0 { 1.0 } else { -1.0 };
+                (spec.axles[w / 2].x, side * 0.5 * spec.axles[w / 2].track)
+            })
+            .collect();
+        let track_runs = TrackRuns::compile(
+            spec,
+            com,
+            &group_of,
+            &wheel_xy,
+            body_stiffness,
+            body_damping,
+        );
         let wheelbase = wheels
             .iter()
             .find(|w| w.steered)
@@ -334,6 +359,7 @@ impl Model {
             }),
             roll_centres,
             beams,
+            track_runs,
         }
     }
 }

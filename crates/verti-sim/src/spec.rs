@@ -8,6 +8,9 @@
 use crate::error::SpecError;
 pub use crate::linkage::{LinkageKind, LinkageSpec};
 use serde::{Deserialize, Serialize};
+pub use track::{RollerSpec, TrackRunsSpec, TrackSpec};
+
+mod track;
 
 /// Most wheels (or road wheels) a vehicle may have; keeps per-step work bounded.
 pub const MAX_WHEELS: usize = 16;
@@ -313,13 +316,6 @@ pub struct PowertrainSpec {
     pub final_drive: f64,
     pub axle_differential: Differential,
     pub central_differential: Differential,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TrackSpec {
-    /// Mass of one track (all shoes) \[kg\]; counted as sprung mass and as spin inertia of its side.
-    pub track_mass: f64,
 }
 
 // `VehicleSpec::from_file` and `VehicleSpec::summary` are in `vehicles.rs`: both compare the
@@ -790,6 +786,11 @@ impl VehicleSpec {
         pos("powertrain.final_drive", p.final_drive)?;
         if let Some(tr) = &self.track {
             nonneg("track.track_mass", tr.track_mass)?;
+            if let Some(runs) = &tr.runs {
+                let (first, last) = (&self.axles[0], &self.axles[self.axles.len() - 1]);
+                runs.check((first.x, first.z), (last.x, last.z), first.wheel.radius)
+                    .map_err(|(field, problem)| bad(field, problem))?;
+            }
             if st.kind != SteeringKind::Skid {
                 return Err(bad(
                     "steering.kind".into(),

@@ -138,6 +138,8 @@ pub struct ContactInfo {
     pub wheels_on_soil: u32,
     /// Soil nodes in contact with wheels.
     pub soil_nodes_in_contact: u32,
+    /// Points of a track's raised ends (both lines) touching terrain or obstacles.
+    pub track_run_points: u32,
 }
 
 /// Everything that changes during a simulation. `Clone` is cheap: a few hundred bytes plus one

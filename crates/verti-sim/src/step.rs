@@ -21,6 +21,7 @@
 //! the wheels before it left in the same step.
 
 use crate::contact::body::body_contacts;
+use crate::contact::track_run::track_run_contacts;
 use crate::contact::wheel::wheel_contact;
 use crate::contact::{WheelContact, WheelKinematics};
 use crate::drivetrain::{self, SpinLoads};
@@ -86,6 +87,10 @@ impl Sim {
         // each wheel's lateral ground force, for the roll-centre links
         let mut lateral = [0.0; MAX_WHEELS];
         let near = terrain.obstacles.near(st.position.x, st.position.y);
+        // a tracked vehicle's raised track ends: their friction joins the spin solve
+        let mut spin_base = SpinLoads::ZERO;
+        let runs = (model.track_runs.as_ref())
+            .map(|r| track_run_contacts(terrain, model, r, st, near, &mut spin_base));
         let rigid = spec.tyre.model == TyreModel::Rigid;
         if rigid {
             let stage = RigidStage {
@@ -93,12 +98,13 @@ impl Sim {
                 wheel_steer,
                 wheel_torque,
                 near,
+                spin_base,
                 h,
             };
             let scratch = (&mut axis_loads, &mut tyres, &mut lateral);
             self.rigid_wheels(st, ctl, &stage, &mut loads, &mut contacts, scratch);
         } else {
-            let mut spin_loads = SpinLoads::ZERO;
+            let mut spin_loads = spin_base;
             let mut axles = [Vec3::ZERO; MAX_WHEELS];
             for (w, m) in model.wheels.iter().enumerate() {
                 let ws = st.wheels[w];
@@ -149,6 +155,11 @@ impl Sim {
                 loads.torque += axles[w] * reaction[m.group];
                 st.wheels[w].spin_rate = st.group_spin[m.group];
             }
+        }
+
+        if let Some(runs) = &runs {
+            runs.apply(&st.group_spin[..model.groups.len()], &mut loads);
+            contacts.track_run_points = runs.points;
         }
 
         // ---- links: the share of the lateral forces a roll centre off the ground carries ----
@@ -253,6 +264,8 @@ pub(crate) struct RigidStage<'a> {
     pub wheel_torque: f64,
     /// Obstacles near the vehicle.
     pub near: &'a [u32],
+    /// Spin loads from before the wheels (the raised track ends' friction).
+    pub spin_base: SpinLoads,
     pub h: f64,
 }
 

@@ -11,7 +11,7 @@
 //! rigid tyres existed.
 
 use crate::contact::rigid::rigid_wheel_contact;
-use crate::drivetrain::{self, CoulombResult, SpinLoads};
+use crate::drivetrain::{self, CoulombResult};
 use crate::friction::{self, CoulombTyre, TyreForces};
 use crate::integrate::Loads;
 use crate::model::GRAVITY;
@@ -49,7 +49,7 @@ impl Sim {
         let gravity = Vec3::new(0.0, 0.0, -GRAVITY);
         let mut coulomb: [Option<CoulombTyre>; MAX_WHEELS] = [None; MAX_WHEELS];
         // explicit spin torques, and the forces of the wheels without a Coulomb contact
-        let mut spin_loads = SpinLoads::ZERO;
+        let mut spin_loads = stage.spin_base;
         let mut axles = [Vec3::ZERO; MAX_WHEELS];
         // a Coulomb contact has no force before the spin solve
         let none = TyreForces::default();

@@ -524,6 +524,28 @@ impl FastObstacle {
         })
     }
 
+    /// How far a point `p` inside a rock must move along the unit direction `u` to leave it
+    /// (the nearest face it exits through); `None` for a tree, for a point outside, or when
+    /// `u` leaves through no face.
+    #[inline]
+    pub fn exit_along(&self, p: verti_core::Vec3, u: verti_core::Vec3) -> Option<f64> {
+        if self.tree.is_some() {
+            return None;
+        }
+        let mut best = f64::INFINITY;
+        for &(n, d) in &self.faces {
+            let inside = d - n.dot(p);
+            if inside < 0.0 {
+                return None;
+            }
+            let rate = n.dot(u);
+            if rate > 1e-9 {
+                best = best.min(inside / rate);
+            }
+        }
+        best.is_finite().then_some(best)
+    }
+
     /// Same contract as `Obstacle::signed_distance`: signed distance (negative inside, exact
     /// inside, a lower bound outside a rock) and the outward normal of the nearest surface.
     #[inline]

@@ -5,7 +5,8 @@
 //! * [`rigid`]: the same for a rigid tyre (a rigid cylinder, `tyre.model: rigid`);
 //! * [`soil`]: SCM under one wheel (pressure–sinkage per node, plastic memory);
 //! * [`body`]: the chassis collision box against terrain and obstacles;
-//! * [`belly`]: the box's bottom face against the terrain between its lattice points.
+//! * [`belly`]: the box's bottom face against the terrain between its lattice points;
+//! * [`track_run`]: a tracked vehicle's raised track ends against terrain and obstacles.
 //!
 //! Wheel contacts return a [`WheelContact`] summary; their tangential forces come later from
 //! the slip state (`friction::tyre_forces`). Body contacts apply their forces, friction
@@ -17,6 +18,7 @@ pub(crate) mod body;
 mod body_tests;
 pub(crate) mod rigid;
 pub(crate) mod soil;
+pub(crate) mod track_run;
 pub(crate) mod wheel;
 
 use verti_core::Vec3;
