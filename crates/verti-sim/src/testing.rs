@@ -182,6 +182,31 @@ pub fn rock_world(scale: f64, friction: f64, front_x: f64, size: Vec3) -> World 
     )
 }
 
+/// Flat ground with one box rock of full size `size` (world units) centred on `centre` (x, y),
+/// sitting on the ground, turned by `yaw` \[rad\] about the vertical.
+pub fn yawed_rock_world(
+    scale: f64,
+    friction: f64,
+    centre: (f64, f64),
+    size: Vec3,
+    yaw: f64,
+) -> World {
+    let rock = Obstacle::rock(
+        box_faces(size),
+        1.0,
+        Vec3::new(centre.0, centre.1, 0.5 * size.z),
+        yaw,
+    )
+    .expect("a box is a valid rock");
+    world_from_fn(
+        "yawed-rock",
+        scale,
+        |_, _| 0.0,
+        uniform(rigid_patch(friction)),
+        vec![rock],
+    )
+}
+
 /// Flat ground with one tree (vertical cylinder of the given radius and height, world units)
 /// centred at (x, 0).
 pub fn tree_world(scale: f64, friction: f64, x: f64, radius: f64, height: f64) -> World {

@@ -6,7 +6,7 @@
 //! Each side is a profile in the chassis' x–z plane: the straight run is the lower common
 //! tangent of the road wheel's circle (centre at the wheel's current travel, so the run follows
 //! the suspension) and the roller's circle, the arc the part of the roller's circle from that
-//! tangent point round to 60° above the horizontal. Every profile point has its outward normal
+//! tangent point round to 50° above the horizontal. Every profile point has its outward normal
 //! `n`; the track's surface there moves along `(n_z, −n_x)` relative to the hull at the road
 //! wheels' rim speed (a loop turning the same way everywhere: backward along the bottom, down
 //! the front run, up the rear one). The profile repeats on two lines across the track, at a
@@ -20,11 +20,14 @@ use verti_core::Vec3;
 pub(crate) const MAX_PROFILE: usize = 2 * (MAX_RUN_POINTS + ARC_POINTS) + 7 * MAX_RUN_POINTS;
 /// Straight-run points per end at most (their spacing grows on a longer run).
 const MAX_RUN_POINTS: usize = 12;
-/// Arc points per roller: every 15° from straight down to 60° above the horizontal.
-const ARC_POINTS: usize = 11;
-/// Wanted spacing of the straight run's points at full scale \[m\] (about a quarter of a road
-/// wheel's radius, so a rock edge between two points still meets the run within ~1 cm).
-const RUN_SPACING: f64 = 0.08;
+/// Arc points per roller: every 20° from straight down to 50° above the horizontal (11 cm
+/// apart on the M113's sprocket).
+const ARC_POINTS: usize = 8;
+/// Wanted spacing of the straight run's points at full scale \[m\] (a third of a road wheel's
+/// radius: a rock's right-angled edge under a run inclined 20–30° sinks at most about a fifth
+/// of the spacing, 2 cm, into the run before a point meets it). The spans between road wheels
+/// take half as many.
+const RUN_SPACING: f64 = 0.1;
 /// How far the track between two road wheels lies inside their common tangent \[m at full
 /// scale\]: four times a road wheel's static tyre deflection (M113: 9.8 kN on 2e6 N/m, 5 mm),
 /// so that on flat ground the road wheels alone carry the vehicle (a real track bends freely
@@ -67,15 +70,13 @@ pub(crate) struct TrackRuns {
     pub mu: f64,
 }
 
-/// One point of a side's profile: position (x, z about the centre of mass), outward normal,
-/// and whether it lies on a straight run (else on a roller's arc).
+/// One point of a side's profile: position (x, z about the centre of mass) and outward normal.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct ProfilePoint {
     pub x: f64,
     pub z: f64,
     pub nx: f64,
     pub nz: f64,
-    pub straight: bool,
 }
 
 impl ProfilePoint {
@@ -104,7 +105,7 @@ impl TrackRuns {
         let spacing = RUN_SPACING * spec.scale;
         let arc = |turn: f64| {
             std::array::from_fn(|k| {
-                let a = -std::f64::consts::FRAC_PI_2 + turn * (k as f64) * 15f64.to_radians();
+                let a = -std::f64::consts::FRAC_PI_2 + turn * (k as f64) * 20f64.to_radians();
                 (libm::cos(a), libm::sin(a))
             })
         };
@@ -159,14 +160,8 @@ impl TrackRuns {
     pub fn profile(&self, hubs: &[(f64, f64)], out: &mut [ProfilePoint; MAX_PROFILE]) -> usize {
         let r = self.wheel_radius;
         let mut n = 0;
-        let mut push = |x: f64, z: f64, nx: f64, nz: f64, straight: bool| {
-            out[n] = ProfilePoint {
-                x,
-                z,
-                nx,
-                nz,
-                straight,
-            };
+        let mut push = |x: f64, z: f64, nx: f64, nz: f64| {
+            out[n] = ProfilePoint { x, z, nx, nz };
             n += 1;
         };
         let (Some(&front), Some(&rear)) = (hubs.first(), hubs.last()) else {
@@ -183,10 +178,11 @@ impl TrackRuns {
                 pair[1].0 + (r - self.inset) * nx,
                 pair[1].1 + (r - self.inset) * nz,
             );
-            let count = self.points_on(a, b);
+            // a span bridges a rock edge only now and then: half as many points
+            let count = self.points_on(a, b).div_ceil(2).max(2);
             for k in 1..count {
                 let t = k as f64 / count as f64;
-                push(a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t, nx, nz, true);
+                push(a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t, nx, nz);
             }
         }
         let ends = [
@@ -200,13 +196,13 @@ impl TrackRuns {
             let count = self.points_on(a, b);
             for k in 1..=count {
                 let t = k as f64 / count as f64;
-                push(a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t, nx, nz, true);
+                push(a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t, nx, nz);
             }
             // the roller's arc beyond the run's tangent point (turning forward round the
             // sprocket, backward round the idler)
             for &(mx, mz) in arc.iter() {
                 if turn * (nx * mz - nz * mx) > 1e-9 {
-                    push(cx + rc * mx, cz + rc * mz, mx, mz, false);
+                    push(cx + rc * mx, cz + rc * mz, mx, mz);
                 }
             }
         }
@@ -226,7 +222,7 @@ impl TrackRuns {
 /// n·(b − a) = ra − rb and a negative z component, so that a + ra·n and b + rb·n lie on one
 /// line perpendicular to `n`.
 #[inline]
-fn lower_tangent(a: (f64, f64), ra: f64, b: (f64, f64), rb: f64) -> (f64, f64) {
+pub(crate) fn lower_tangent(a: (f64, f64), ra: f64, b: (f64, f64), rb: f64) -> (f64, f64) {
     let (dx, dz) = (b.0 - a.0, b.1 - a.1);
     let d = (dx * dx + dz * dz).sqrt();
     let (ux, uz) = (dx / d, dz / d);

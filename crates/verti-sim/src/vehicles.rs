@@ -146,10 +146,15 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             chassis: "2-tracked",
             suspension_families: &["tensioned"],
             steering_families: &["differential"],
-            suspension: "torsion-arm road wheels on a tensioned track, modelled as independent road wheels tied to one spin per side",
+            suspension: "torsion-arm road wheels on a tensioned track, modelled as independent road \
+                         wheels tied to one spin per side; the track's raised ends (first road wheel \
+                         up to the sprocket, last one up to the idler) and the spans between road \
+                         wheels touch the ground and obstacles, and the moving track drives over \
+                         what they touch",
             steering: "differential (skid) steering: a steer unit holds the inner track at the speed \
                        ratio that gives the path of an equivalent bicycle (the HMMWV's minimum radius \
-                       at full input), with a limited steer-brake torque",
+                       at full input), corrected by the yaw rate's shortfall, with a limited \
+                       steer-brake torque",
             source: "Chrono M113 (physics_spec §3.3); torsion rate, dampers, gears chosen",
         },
         "uaz" => Mechanisms {

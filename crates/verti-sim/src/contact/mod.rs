@@ -19,6 +19,8 @@ mod body_tests;
 pub(crate) mod rigid;
 pub(crate) mod soil;
 pub(crate) mod track_run;
+#[cfg(test)]
+mod track_run_tests;
 pub(crate) mod wheel;
 
 use verti_core::Vec3;

@@ -24,10 +24,18 @@ use crate::terrain::Terrain;
 use crate::track_runs::{MAX_PROFILE, ProfilePoint, TrackRuns};
 use verti_core::Vec3;
 
-/// A straight run's point is pushed along the run's normal only while that frees it within 4
-/// times its shortest way out (the ground's or rock face's normal); beyond (the run's normal
-/// nearly along the surface, e.g. a run pressed into a wall) the surface's normal takes over.
+/// A point is pushed along the track's normal only while that frees it within 4 times its
+/// shortest way out (the rock face's normal); beyond (the track's normal nearly along the
+/// face, e.g. a run pressed flat against a rock's side) the face's normal takes over.
 const MIN_EXIT_RATE: f64 = 0.25;
+
+/// A rock face whose normal points more than 30° across the vehicle (|n·y| ≥ 0.5) meets the
+/// track's outer corner or side rather than its running surface.
+const MAX_ACROSS: f64 = 0.5;
+
+/// Obstacles one side's points test (those whose bounding sphere reaches the points' box; a
+/// side meets a handful at a time, and beyond this many it tests every obstacle near).
+const MAX_CANDIDATES: usize = 16;
 
 /// The runs' forces on the hull, linear in the sides' new spins: F = F₀ + Σ_g ω_g F_g (and
 /// the same for the moment about the centre of mass).
@@ -111,38 +119,80 @@ pub(crate) fn track_run_contacts(
             spin.stiffness[g] += c * r * r * bt.dot(belt);
             out.points += 1;
         };
-        for pt in &profile[..count] {
-            let belt = rm.mul_vec(pt.belt());
-            // A straight run is a flat belt: whatever pokes into it (a rock's edge, a ridge's
-            // crest) pushes it along its own normal, by how far the point must move that way
-            // to come free. Pushed along the rock face's normal instead, an edge under the
-            // front run would hold the vehicle back horizontally where the run rides up it. A
-            // roller is round and meets a surface along the surface's normal.
-            let inward = rm.mul_vec(Vec3::new(-pt.nx, 0.0, -pt.nz));
-            for &y in &side.lines {
+        // where every point is (both lines), the box around them, and the obstacles whose
+        // bounding sphere reaches that box: the points test only those
+        let mut arms = [Vec3::ZERO; 2 * MAX_PROFILE];
+        let inf = f64::INFINITY;
+        let (mut lo, mut hi) = (Vec3::new(inf, inf, inf), Vec3::new(-inf, -inf, -inf));
+        for (k, pt) in profile[..count].iter().enumerate() {
+            for (j, &y) in side.lines.iter().enumerate() {
                 let arm = rm.mul_vec(Vec3::new(pt.x, y, pt.z));
                 let p = st.position + arm;
-                if p.z < terrain.bound.max_at(p.x, p.y) {
+                lo = Vec3::new(lo.x.min(p.x), lo.y.min(p.y), lo.z.min(p.z));
+                hi = Vec3::new(hi.x.max(p.x), hi.y.max(p.y), hi.z.max(p.z));
+                arms[2 * k + j] = arm;
+            }
+        }
+        let mut candidates = [0u32; MAX_CANDIDATES];
+        let mut n_candidates = 0;
+        let mut overflow = false;
+        for &k in near {
+            let fo = &terrain.fast_obstacles[k as usize];
+            let c = fo.center;
+            let gap = Vec3::new(
+                (lo.x - c.x).max(c.x - hi.x).max(0.0),
+                (lo.y - c.y).max(c.y - hi.y).max(0.0),
+                (lo.z - c.z).max(c.z - hi.z).max(0.0),
+            );
+            if gap.norm_sq() <= fo.radius * fo.radius {
+                if n_candidates == MAX_CANDIDATES {
+                    overflow = true;
+                } else {
+                    candidates[n_candidates] = k;
+                    n_candidates += 1;
+                }
+            }
+        }
+        let tested = if overflow {
+            near
+        } else {
+            &candidates[..n_candidates]
+        };
+        let across = rm.mul_vec(Vec3::Y);
+        let ground_near = lo.z < terrain.bound.max_in(lo.x, lo.y, hi.x, hi.y);
+        for (k, pt) in profile[..count].iter().enumerate() {
+            let belt = rm.mul_vec(pt.belt());
+            // Against a rock, the track's own normal: whatever sharp edge pokes into the
+            // track's smooth, convex surface pushes along that surface's normal, by how far the
+            // point must move that way to come free. Pushed along the rock face's normal
+            // instead, an edge under the front run or the sprocket would hold the vehicle back
+            // horizontally where the track rides up it (against a flat face the deepest
+            // points' normals are the face's anyway). The ground is smooth (a triangulated
+            // heightfield whose kinks are obtuse): the ground's normal there.
+            let inward = rm.mul_vec(Vec3::new(-pt.nx, 0.0, -pt.nz));
+            for &arm in &arms[2 * k..2 * k + 2] {
+                let p = st.position + arm;
+                if ground_near && p.z < terrain.bound.max_at(p.x, p.y) {
                     let (h, gx, gy) = terrain.ground.sample(p.x, p.y);
-                    let surface = &patches[terrain.ground.patch_index(p.x, p.y)].surface;
-                    let h = match surface {
-                        verti_world::Surface::Deformable { .. } => h - model.soil_floor,
-                        verti_world::Surface::Rigid { .. } => h,
+                    let surface = if h > p.z {
+                        Some(&patches[terrain.ground.patch_index(p.x, p.y)].surface)
+                    } else {
+                        None
                     };
-                    if h > p.z {
+                    let h = match surface {
+                        Some(verti_world::Surface::Deformable { .. }) => h - model.soil_floor,
+                        _ => h,
+                    };
+                    if let Some(surface) = surface
+                        && h > p.z
+                    {
                         let mu = surface_mu(surface).min(runs.mu);
-                        // rise of the ground-relative height per unit move along `inward`
-                        let rate = inward.z - gx * inward.x - gy * inward.y;
-                        if pt.straight && rate >= MIN_EXIT_RATE {
-                            touch(arm, belt, inward, (h - p.z) / rate, mu);
-                        } else {
-                            let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
-                            let n = Vec3::new(-gx * nz, -gy * nz, nz);
-                            touch(arm, belt, n, (h - p.z) * nz, mu);
-                        }
+                        let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
+                        let n = Vec3::new(-gx * nz, -gy * nz, nz);
+                        touch(arm, belt, n, (h - p.z) * nz, mu);
                     }
                 }
-                for &k in near {
+                for &k in tested {
                     let fo = &terrain.fast_obstacles[k as usize];
                     if (p - fo.center).norm_sq() > fo.radius * fo.radius {
                         continue;
@@ -152,10 +202,16 @@ pub(crate) fn track_run_contacts(
                         continue;
                     }
                     let mu = OBSTACLE_FRICTION.min(runs.mu);
-                    match fo.exit_along(p, inward) {
-                        Some(t) if pt.straight && t <= -d / MIN_EXIT_RATE => {
-                            touch(arm, belt, inward, t, mu)
-                        }
+                    // a face turned across the track (a rock met at an angle or scraped
+                    // past) meets the track's corner or side, which it pushes along its own
+                    // normal, sideways too
+                    let exit = if n.dot(across).abs() < MAX_ACROSS {
+                        fo.exit_along(p, inward)
+                    } else {
+                        None
+                    };
+                    match exit {
+                        Some(t) if t <= -d / MIN_EXIT_RATE => touch(arm, belt, inward, t, mu),
                         _ => touch(arm, belt, n, -d, mu),
                     }
                 }
