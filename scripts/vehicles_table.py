@@ -21,7 +21,7 @@ VEHICLES = [
     ("gator", "1", "4 wheels, single wishbone, rack and pinion"),
     ("sedan", "1", "4 wheels, double wishbone / multilink, rack and pinion"),
     ("truck6", "1", "6 wheels, three-link solid axles, rotary arm and bellcrank"),
-    ("truck8", "1", "8 wheels, three-link solid axles, two steered axles (Ackermann)"),
+    ("truck8", "1", "8 wheels, three-link solid axles, a rotary arm and bellcrank on each of two steered axles"),
     ("m113", "1", "2 tracks, skid steering (steer unit)"),
     ("artcar", "1/6", "4 wheels, double wishbone, Pitman arm"),
     ("verti4", "1/10", "4 wheels, independent wheels, Ackermann"),

@@ -8,7 +8,7 @@
 use crate::friction::{CoulombTyre, LongTyre};
 use crate::math::{RPM_TO_RAD_S, soft_sign};
 use crate::model::{LINKAGE_SAMPLES, Model, WheelModel};
-use crate::spec::{MAX_WHEELS, PowertrainSpec, SteeringKind, VehicleSpec};
+use crate::spec::{MAX_LINKAGES, MAX_WHEELS, PowertrainSpec, SteeringKind, VehicleSpec};
 use crate::state::{Controls, SimState};
 
 // ---- steering ----
@@ -19,8 +19,9 @@ pub(crate) struct WheelSteer {
     /// Ackermann: the turn radius of the rear-axle centre (infinite when straight, for skid
     /// steering and for a linkage).
     pub turn_radius: f64,
-    /// Linkage: (sin δ, cos δ) of the left and right steered wheels' angles.
-    pub linkage: Option<[(f64, f64); 2]>,
+    /// Linkage: (sin δ, cos δ) of the left and right steered wheels' angles, per steered
+    /// axle (the first `linkages`).
+    pub linkage: Option<[[(f64, f64); 2]; MAX_LINKAGES]>,
 }
 
 /// Moves the steering toward the driver's input at the steering's slew rate: the bicycle-model
@@ -44,21 +45,25 @@ pub(crate) fn steer(
 /// How the steered wheels point for the bicycle angle `steer`.
 #[inline]
 pub(crate) fn wheel_steer(spec: &VehicleSpec, model: &Model, steer: f64) -> WheelSteer {
-    let linkage = model.linkage_table.as_ref().map(|table| {
-        // the linkage's input; its table is interpolated linearly and the (sin, cos) pairs
+    let linkage = (!model.linkage_tables.is_empty()).then(|| {
+        // the linkages' input; each table is interpolated linearly and the (sin, cos) pairs
         // normalised again
         let input = (steer / spec.steering.max_angle_deg.to_radians()).clamp(-1.0, 1.0);
         let at = (input + 1.0) * 0.5 * LINKAGE_SAMPLES as f64;
         let k = (at as usize).min(LINKAGE_SAMPLES - 1);
         let t = at - k as f64;
-        let (a, b) = (&table[k], &table[k + 1]);
-        let side = |j: usize| {
-            let sin = a[j].0 + t * (b[j].0 - a[j].0);
-            let cos = a[j].1 + t * (b[j].1 - a[j].1);
-            let norm = (sin * sin + cos * cos).sqrt();
-            (sin / norm, cos / norm)
-        };
-        [side(0), side(1)]
+        let mut out = [[(0.0, 1.0); 2]; MAX_LINKAGES];
+        for (sides, table) in out.iter_mut().zip(&model.linkage_tables) {
+            let (a, b) = (&table[k], &table[k + 1]);
+            let side = |j: usize| {
+                let sin = a[j].0 + t * (b[j].0 - a[j].0);
+                let cos = a[j].1 + t * (b[j].1 - a[j].1);
+                let norm = (sin * sin + cos * cos).sqrt();
+                (sin / norm, cos / norm)
+            };
+            *sides = [side(0), side(1)];
+        }
+        out
     });
     WheelSteer {
         turn_radius: turn_radius(spec, model, steer),
@@ -127,9 +132,9 @@ pub(crate) fn turn_radius(spec: &VehicleSpec, model: &Model, steer: f64) -> f64 
 /// trigonometric calls. Linkage: the linkage's angle for the wheel's side.
 #[inline]
 pub(crate) fn steer_sin_cos(m: &WheelModel, steer: &WheelSteer) -> (f64, f64) {
-    if let Some(sides) = &steer.linkage {
+    if let Some(axles) = &steer.linkage {
         return if m.steered {
-            sides[usize::from(m.y < 0.0)]
+            axles[m.linkage][usize::from(m.y < 0.0)]
         } else {
             (0.0, 1.0)
         };

@@ -236,3 +236,79 @@ pub(crate) fn check(l: &LinkageSpec) -> Result<(), String> {
     }
     Ok(())
 }
+
+/// Checks one linkage block of a vehicle file, named `field` in errors (`steering.linkage`,
+/// `axles[1].linkage`): the points its kind needs are given and finite, the mirrored ones on
+/// the left, none it does not use; its travel or arm is positive; it closes over the whole
+/// input range. Returns the bad field and why.
+pub(crate) fn validate(l: &LinkageSpec, field: &str) -> Result<(), (String, String)> {
+    let needed: &[&str] = match l.kind {
+        LinkageKind::RackAndPinion | LinkageKind::PitmanArm => &["tie_rod_inner"],
+        LinkageKind::ToeBar => &["drag_arm", "drag_link_end", "drag_kingpin"],
+        LinkageKind::Bellcrank => &[
+            "tie_rod_inner",
+            "drag_arm",
+            "drag_link_end",
+            "drag_kingpin",
+            "arm_pivot",
+        ],
+    };
+    // points a mirror image is taken of lie on the left; a bellcrank's drive may not
+    let anywhere: &[&str] = match l.kind {
+        LinkageKind::Bellcrank => &["drag_link_end", "drag_kingpin", "arm_pivot"],
+        _ => &[],
+    };
+    let points = [
+        ("kingpin", Some(l.kingpin)),
+        ("steering_arm", Some(l.steering_arm)),
+        ("tie_rod_inner", l.tie_rod_inner),
+        ("drag_arm", l.drag_arm),
+        ("drag_link_end", l.drag_link_end),
+        ("drag_kingpin", l.drag_kingpin),
+        ("arm_pivot", l.arm_pivot),
+    ];
+    let bad = |name: &str, problem: String| Err((format!("{field}.{name}"), problem));
+    for (name, p) in points {
+        match p {
+            None if needed.contains(&name) => {
+                return bad(name, format!("missing: a {:?} linkage needs it", l.kind));
+            }
+            Some(_) if !needed.contains(&name) && !matches!(name, "kingpin" | "steering_arm") => {
+                return bad(name, format!("not used by a {:?} linkage", l.kind));
+            }
+            Some(p) if !(p[0].is_finite() && p[1].is_finite()) => {
+                return bad(name, format!("{p:?} must be a finite point"));
+            }
+            Some(p) if p[1] <= 0.0 && !anywhere.contains(&name) => {
+                return bad(
+                    name,
+                    format!("{p:?} must be a finite point on the left side (y > 0)"),
+                );
+            }
+            _ => {}
+        }
+    }
+    let positive = |name: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            bad(name, format!("{v} must be a positive finite number"))
+        }
+    };
+    match l.kind {
+        LinkageKind::RackAndPinion => positive("rack_travel", l.rack_travel)?,
+        LinkageKind::PitmanArm | LinkageKind::ToeBar => positive("arm_length", l.arm_length)?,
+        // its arm's length is the distance from `arm_pivot` to `drag_link_end`
+        LinkageKind::Bellcrank => {}
+    }
+    // every kind but the rack turns an arm
+    if l.kind != LinkageKind::RackAndPinion
+        && !(l.arm_max_angle_deg > 0.0 && l.arm_max_angle_deg < 90.0)
+    {
+        return bad(
+            "arm_max_angle_deg",
+            format!("{} must be in (0, 90)", l.arm_max_angle_deg),
+        );
+    }
+    check(l).map_err(|e| (field.to_string(), e))
+}

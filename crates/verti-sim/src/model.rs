@@ -29,6 +29,8 @@ pub(crate) struct WheelModel {
     /// x relative to the mean of the unsteered axles (for Ackermann).
     pub ackermann_dx: f64,
     pub steered: bool,
+    /// A steered wheel's linkage: its axle's rank among the steered axles.
+    pub linkage: usize,
     pub driven: bool,
     pub radius: f64,
     pub half_width: f64,
@@ -117,10 +119,11 @@ pub(crate) struct Model {
     pub driven_wheels: usize,
     /// Distance from the first steered axle to the mean of the unsteered ones (Ackermann).
     pub wheelbase: f64,
-    /// A steering linkage's (sin δ, cos δ) of the left and right steered wheels at
+    /// Each steering linkage's (sin δ, cos δ) of the left and right steered wheels at
     /// [`LINKAGE_SAMPLES`] + 1 evenly spaced inputs from −1 to 1 (the closed form costs a
-    /// dozen trigonometric calls, too many for every internal step).
-    pub linkage_table: Option<Vec<[(f64, f64); 2]>>,
+    /// dozen trigonometric calls, too many for every internal step), one per steered axle
+    /// in axle order; empty unless the steering is `kind: linkage`.
+    pub linkage_tables: Vec<Vec<[(f64, f64); 2]>>,
     /// Whether any axle has a roll centre above (or below) the ground.
     pub roll_centres: bool,
     /// Whether any solid axle's beam has its own roll inertia (its wheels update as a pair).
@@ -129,7 +132,7 @@ pub(crate) struct Model {
     pub track_runs: Option<TrackRuns>,
 }
 
-/// Intervals of [`Model::linkage_table`]: between samples the wheel angle changes by at most
+/// Intervals of [`Model::linkage_tables`]: between samples the wheel angle changes by at most
 /// ~0.005 rad, so interpolating sine and cosine and normalising is within ~1e-6 rad of the
 /// closed form.
 pub(crate) const LINKAGE_SAMPLES: usize = 400;
@@ -239,6 +242,7 @@ impl Model {
                     y: side * 0.5 * ax.track,
                     ackermann_dx: ax.x - x_rear,
                     steered: ax.steered,
+                    linkage: spec.axles[..k].iter().filter(|a| a.steered).count(),
                     driven: ax.driven,
                     radius: ax.wheel.radius,
                     half_width: 0.5 * ax.wheel.width,
@@ -343,25 +347,41 @@ impl Model {
             soil_floor,
             driven_wheels,
             wheelbase,
-            linkage_table: spec.steering.linkage.as_ref().map(|l| {
-                (0..=LINKAGE_SAMPLES)
-                    .map(|k| {
-                        let u = -1.0 + 2.0 * k as f64 / LINKAGE_SAMPLES as f64;
-                        // validation checked that the linkage closes over the whole range
-                        let (left, right) =
-                            crate::linkage::wheel_angles(l, u).unwrap_or((0.0, 0.0));
-                        [
-                            (libm::sin(left), libm::cos(left)),
-                            (libm::sin(right), libm::cos(right)),
-                        ]
-                    })
-                    .collect()
-            }),
+            linkage_tables: linkages(spec)
+                .iter()
+                .map(|l| {
+                    (0..=LINKAGE_SAMPLES)
+                        .map(|k| {
+                            let u = -1.0 + 2.0 * k as f64 / LINKAGE_SAMPLES as f64;
+                            // validation checked that the linkage closes over the whole range
+                            let (left, right) =
+                                crate::linkage::wheel_angles(l, u).unwrap_or((0.0, 0.0));
+                            [
+                                (libm::sin(left), libm::cos(left)),
+                                (libm::sin(right), libm::cos(right)),
+                            ]
+                        })
+                        .collect()
+                })
+                .collect(),
             roll_centres,
             beams,
             track_runs,
         }
     }
+}
+
+/// The steering linkages of a `kind: linkage` vehicle, one per steered axle in axle order:
+/// the first steered axle's is `steering.linkage`, each further one's its own (empty for the
+/// other kinds).
+pub(crate) fn linkages(spec: &VehicleSpec) -> Vec<crate::spec::LinkageSpec> {
+    let Some(first) = spec.steering.linkage else {
+        return Vec::new();
+    };
+    let further = spec.axles.iter().filter(|a| a.steered).skip(1);
+    std::iter::once(first)
+        .chain(further.filter_map(|a| a.linkage))
+        .collect()
 }
 
 /// Static spring compression per axle: a rigid chassis on the axle springs (heave and pitch),

@@ -14,6 +14,8 @@ mod track;
 
 /// Most wheels (or road wheels) a vehicle may have; keeps per-step work bounded.
 pub const MAX_WHEELS: usize = 16;
+/// Most steered axles a vehicle with `steering.kind: linkage` may have (one linkage each).
+pub const MAX_LINKAGES: usize = 4;
 
 /// Largest torque \[N m\] a powertrain map may give: the built-in vehicles stay below 2000,
 /// the largest mining trucks below 1e5.
@@ -96,6 +98,10 @@ pub struct AxleSpec {
     /// An anti-roll (stabiliser) bar between the two wheels of the axle.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub anti_roll_bar: Option<AntiRollBarSpec>,
+    /// A steered axle after the first of a `steering.kind: linkage` vehicle: its own linkage
+    /// (points relative to the axle's x), driven by the same steering input.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub linkage: Option<LinkageSpec>,
 }
 
 /// An anti-roll bar: a torsion bar whose arms push each wheel of the axle towards its
@@ -262,9 +268,9 @@ pub enum SteeringKind {
     /// `max_angle_deg`): the same steering input means the same path for every vehicle
     /// (tracked vehicles; see `drivetrain::skid_speed_ratio`).
     Skid,
-    /// The steered axle's wheels turn through a steering linkage (`linkage`): a rack and
-    /// pinion, a Pitman arm, a toe bar or a bellcrank, each wheel by the angle the linkage
-    /// gives it.
+    /// The steered axles' wheels turn through steering linkages: a rack and pinion, a Pitman
+    /// arm, a toe bar or a bellcrank, each wheel by the angle its axle's linkage gives it
+    /// (`linkage` for the first steered axle, `axles[i].linkage` for each further one).
     Linkage,
 }
 
@@ -283,7 +289,7 @@ pub struct SteeringSpec {
     /// beyond it the unit slips and the vehicle turns wider than asked.
     #[serde(default)]
     pub skid_brake_torque: f64,
-    /// Linkage: the steering linkage (absent for the other kinds).
+    /// Linkage: the first steered axle's linkage (absent for the other kinds).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub linkage: Option<LinkageSpec>,
 }
@@ -598,87 +604,8 @@ impl VehicleSpec {
             ));
         }
         if let Some(l) = &st.linkage {
-            let needed: &[&str] = match l.kind {
-                LinkageKind::RackAndPinion | LinkageKind::PitmanArm => &["tie_rod_inner"],
-                LinkageKind::ToeBar => &["drag_arm", "drag_link_end", "drag_kingpin"],
-                LinkageKind::Bellcrank => &[
-                    "tie_rod_inner",
-                    "drag_arm",
-                    "drag_link_end",
-                    "drag_kingpin",
-                    "arm_pivot",
-                ],
-            };
-            // points a mirror image is taken of lie on the left; a bellcrank's drive may not
-            let anywhere: &[&str] = match l.kind {
-                LinkageKind::Bellcrank => &["drag_link_end", "drag_kingpin", "arm_pivot"],
-                _ => &[],
-            };
-            let points = [
-                ("kingpin", Some(l.kingpin)),
-                ("steering_arm", Some(l.steering_arm)),
-                ("tie_rod_inner", l.tie_rod_inner),
-                ("drag_arm", l.drag_arm),
-                ("drag_link_end", l.drag_link_end),
-                ("drag_kingpin", l.drag_kingpin),
-                ("arm_pivot", l.arm_pivot),
-            ];
-            for (name, p) in points {
-                match p {
-                    None if needed.contains(&name) => {
-                        return Err(bad(
-                            format!("steering.linkage.{name}"),
-                            format!("missing: a {:?} linkage needs it", l.kind),
-                        ));
-                    }
-                    Some(_)
-                        if !needed.contains(&name)
-                            && !matches!(name, "kingpin" | "steering_arm") =>
-                    {
-                        return Err(bad(
-                            format!("steering.linkage.{name}"),
-                            format!("not used by a {:?} linkage", l.kind),
-                        ));
-                    }
-                    Some(p) if !(p[0].is_finite() && p[1].is_finite()) => {
-                        return Err(bad(
-                            format!("steering.linkage.{name}"),
-                            format!("{p:?} must be a finite point"),
-                        ));
-                    }
-                    Some(p) if p[1] <= 0.0 && !anywhere.contains(&name) => {
-                        return Err(bad(
-                            format!("steering.linkage.{name}"),
-                            format!("{p:?} must be a finite point on the left side (y > 0)"),
-                        ));
-                    }
-                    _ => {}
-                }
-            }
-            match l.kind {
-                LinkageKind::RackAndPinion => pos("steering.linkage.rack_travel", l.rack_travel)?,
-                LinkageKind::PitmanArm | LinkageKind::ToeBar => {
-                    pos("steering.linkage.arm_length", l.arm_length)?;
-                }
-                // its arm's length is the distance from `arm_pivot` to `drag_link_end`
-                LinkageKind::Bellcrank => {}
-            }
-            // every kind but the rack turns an arm
-            if l.kind != LinkageKind::RackAndPinion
-                && !(l.arm_max_angle_deg > 0.0 && l.arm_max_angle_deg < 90.0)
-            {
-                return Err(bad(
-                    "steering.linkage.arm_max_angle_deg".into(),
-                    format!("{} must be in (0, 90)", l.arm_max_angle_deg),
-                ));
-            }
-            crate::linkage::check(l).map_err(|e| bad("steering.linkage".into(), e))?;
-            if self.axles.iter().filter(|a| a.steered).count() != 1 {
-                return Err(bad(
-                    "axles".into(),
-                    "a steering linkage steers exactly one axle".into(),
-                ));
-            }
+            crate::linkage::validate(l, "steering.linkage")
+                .map_err(|(field, problem)| bad(field, problem))?;
             // the systems plan with a bicycle of `max_angle_deg`: it must be the linkage's
             // (the mean of the two directions' where left and right locks differ)
             let full = crate::linkage::full_lock_bicycle_angle(l).to_degrees();
@@ -691,6 +618,41 @@ impl VehicleSpec {
                     ),
                 ));
             }
+        }
+        // with `kind: linkage` the first steered axle takes `steering.linkage`, every further
+        // steered axle its own `linkage`; no other axle has one
+        let first_steered = self.axles.iter().position(|a| a.steered);
+        for (k, ax) in self.axles.iter().enumerate() {
+            let field = format!("axles[{k}].linkage");
+            let wanted = st.kind == SteeringKind::Linkage && ax.steered && Some(k) != first_steered;
+            match (&ax.linkage, wanted) {
+                (Some(l), true) => crate::linkage::validate(l, &field)
+                    .map_err(|(field, problem)| bad(field, problem))?,
+                (None, true) => {
+                    return Err(bad(
+                        field,
+                        "missing: with `steering.kind: linkage`, a steered axle after the first \
+                         gives its own linkage"
+                            .into(),
+                    ));
+                }
+                (Some(_), false) => {
+                    return Err(bad(
+                        field,
+                        "only a steered axle after the first, with `steering.kind: linkage`, \
+                         has its own linkage (the first steered axle's is `steering.linkage`)"
+                            .into(),
+                    ));
+                }
+                (None, false) => {}
+            }
+        }
+        let steered = self.axles.iter().filter(|a| a.steered).count();
+        if st.kind == SteeringKind::Linkage && steered > MAX_LINKAGES {
+            return Err(bad(
+                "axles".into(),
+                format!("{steered} steered axles: linkage steering takes at most {MAX_LINKAGES}"),
+            ));
         }
         match st.kind {
             SteeringKind::Ackermann | SteeringKind::Linkage => {

@@ -139,8 +139,8 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
         ),
         "truck8" => man(
             "8-wheeled",
-            "rotary arms and bellcranks on two steered axles, modelled as Ackermann geometry (a \
-             linkage here steers one axle)",
+            "a rotary arm and bellcrank on each of the two steered axles (Chrono's MAN 10t), both \
+             driven by the one input: each wheel's angle from its axle's linkage's geometry",
         ),
         "m113" => Mechanisms {
             chassis: "2-tracked",
@@ -326,16 +326,29 @@ impl VehicleSpec {
                 );
             }
             SteeringKind::Linkage => {
-                if let Some(l) = &self.steering.linkage {
+                // each steered axle's linkage, its wheels' locks against ideal Ackermann
+                // geometry about the unsteered axles' mean line
+                let unsteered: Vec<f64> = (self.axles.iter())
+                    .filter(|a| !a.steered)
+                    .map(|a| a.x)
+                    .collect();
+                let x_rear = unsteered.iter().sum::<f64>() / unsteered.len().max(1) as f64;
+                let steered = self.axles.iter().enumerate().filter(|(_, a)| a.steered);
+                for (rank, ((k, ax), l)) in steered.zip(crate::model::linkages(self)).enumerate() {
                     let mechanism = match l.kind {
                         crate::spec::LinkageKind::RackAndPinion => "rack and pinion",
                         crate::spec::LinkageKind::PitmanArm => "Pitman arm",
                         crate::spec::LinkageKind::ToeBar => "toe bar",
                         crate::spec::LinkageKind::Bellcrank => "rotary arm and bellcrank",
                     };
-                    let _ = write!(s, "  steering         {mechanism} linkage; at full lock");
+                    let label = if rank == 0 {
+                        "  steering        ".to_string()
+                    } else {
+                        format!("    axle {k}        ")
+                    };
+                    let _ = write!(s, "{label} {mechanism} linkage; at full lock");
                     for (turn, u) in [("left", 1.0), ("right", -1.0)] {
-                        let (left, right) = crate::linkage::wheel_angles(l, u).unwrap_or_default();
+                        let (left, right) = crate::linkage::wheel_angles(&l, u).unwrap_or_default();
                         let (inner, outer) = if u > 0.0 {
                             (left, right)
                         } else {
@@ -343,8 +356,7 @@ impl VehicleSpec {
                         };
                         // the outer angle ideal Ackermann geometry gives for this inner one
                         let kingpins = 2.0 * l.kingpin[1];
-                        let ideal =
-                            (1.0 / (1.0 / inner.tan() + kingpins / self.wheelbase())).atan();
+                        let ideal = (1.0 / (1.0 / inner.tan() + kingpins / (ax.x - x_rear))).atan();
                         let _ = write!(
                             s,
                             " {turn}: inner {:.1}°, outer {:.1}° (ideal {:.1}°)",
@@ -353,12 +365,16 @@ impl VehicleSpec {
                             ideal.to_degrees()
                         );
                     }
-                    let _ = writeln!(
-                        s,
-                        "; bicycle {:.2}°, {:.0}°/s",
-                        crate::linkage::full_lock_bicycle_angle(l).to_degrees(),
-                        self.steering.rate_deg_per_s
-                    );
+                    if rank == 0 {
+                        let _ = writeln!(
+                            s,
+                            "; bicycle {:.2}°, {:.0}°/s",
+                            crate::linkage::full_lock_bicycle_angle(&l).to_degrees(),
+                            self.steering.rate_deg_per_s
+                        );
+                    } else {
+                        let _ = writeln!(s, "; the same input");
+                    }
                 }
             }
             SteeringKind::Skid => {

@@ -1,6 +1,6 @@
 //! Steering linkages (rack and pinion, Pitman arm, toe bar, bellcrank) against their
 //! derivation: the road-wheel angles of the Gator's and the Sedan's racks, the ARTcar's Pitman
-//! arm, the UAZ's toe bar and the truck6's rotary arm and bellcrank, from Chrono's
+//! arm, the UAZ's toe bar and the truck6's and truck8's rotary arms and bellcranks, from Chrono's
 //! hardpoints projected on the ground plane, worked out independently of this code (a Python
 //! derivation of the same four-bar closed form from the hardpoints: left and right angles for
 //! inputs 0.25 to 1, to 0.01°), and the limits that follow from the geometry by hand.
@@ -131,6 +131,20 @@ fn truck6_rotary_arm_and_bellcrank() {
         false,
     );
     let l = linkage("truck6");
+    bellcrank_by_bisection(&l);
+    // the locks differ: the bicycle angle is 39.6° turning left, 32.3° turning right, and the
+    // vehicle file's 35.96° is their mean
+    let (l1, r1) = wheel_angles(&l, 1.0).unwrap();
+    let (l2, r2) = wheel_angles(&l, -1.0).unwrap();
+    assert!((bicycle_angle(l1, r1).to_degrees() - 39.62).abs() < 0.01);
+    assert!((-bicycle_angle(l2, r2).to_degrees() - 32.29).abs() < 0.01);
+}
+
+/// A bellcrank linkage's wheel angles against the geometry solved numerically: at inputs −1 to
+/// 1, the rotary arm's end turned about its pivot, the bellcrank's angle that keeps the drag
+/// link's length and each knuckle's angle that keeps its tie rod's, found by bisection,
+/// within 1e-9 rad of the closed form.
+fn bellcrank_by_bisection(l: &LinkageSpec) {
     let rot = |p: [f64; 2], c: [f64; 2], a: f64| {
         let (s, co) = a.sin_cos();
         let (x, y) = (p[0] - c[0], p[1] - c[1]);
@@ -175,18 +189,52 @@ fn truck6_rotary_arm_and_bellcrank() {
         };
         let left = side(l.kingpin, l.steering_arm, inner0);
         let right = side(mirror(l.kingpin), mirror(l.steering_arm), mirror(inner0));
-        let (wl, wr) = wheel_angles(&l, u).unwrap();
+        let (wl, wr) = wheel_angles(l, u).unwrap();
         assert!(
             (wl - left).abs() < 1e-9 && (wr - right).abs() < 1e-9,
             "input {u}: {wl} {wr} vs {left} {right}"
         );
     }
-    // the locks differ: the bicycle angle is 39.6° turning left, 32.3° turning right, and the
-    // vehicle file's 35.96° is their mean
-    let (l1, r1) = wheel_angles(&l, 1.0).unwrap();
-    let (l2, r2) = wheel_angles(&l, -1.0).unwrap();
-    assert!((bicycle_angle(l1, r1).to_degrees() - 39.62).abs() < 0.01);
-    assert!((-bicycle_angle(l2, r2).to_degrees() - 32.29).abs() < 0.01);
+}
+
+// The truck8's two rotary arms and bellcranks (Chrono's MAN 10t: the MAN 7t's mechanism on
+// each steered axle, the second arm turning 28.37° where the first turns 39°, and each axle's
+// own knuckle joint): each against its geometry solved numerically, and the two axles' turn
+// centres at full lock against ideal Ackermann geometry about the rear bogie's centre line.
+#[test]
+fn truck8_two_rotary_arms_and_bellcranks() {
+    let spec = vehicles::builtin("truck8").unwrap();
+    let first = spec.steering.linkage.unwrap();
+    let second = spec.axles[1].linkage.unwrap();
+    bellcrank_by_bisection(&first);
+    bellcrank_by_bisection(&second);
+    let x_rear = 0.5 * (spec.axles[2].x + spec.axles[3].x);
+    let mut mean = 0.0;
+    for u in [1.0, -1.0] {
+        let (l1, r1) = wheel_angles(&first, u).unwrap();
+        let (l2, r2) = wheel_angles(&second, u).unwrap();
+        let (b1, b2) = (bicycle_angle(l1, r1), bicycle_angle(l2, r2));
+        // ideal: both axles' centre lines point at one turn centre on the rear bogie's line,
+        // tan δ2 / tan δ1 = (x2 − x_rear) / (x1 − x_rear)
+        let ideal = (spec.axles[1].x - x_rear) / (spec.axles[0].x - x_rear);
+        let ratio = b2.tan() / b1.tan();
+        println!(
+            "truck8 input {u}: first axle {:.2}° / {:.2}° (bicycle {:.2}°), second {:.2}° / \
+             {:.2}° (bicycle {:.2}°); tan ratio {ratio:.4} against Ackermann's {ideal:.4}",
+            l1.to_degrees(),
+            r1.to_degrees(),
+            b1.to_degrees(),
+            l2.to_degrees(),
+            r2.to_degrees(),
+            b2.to_degrees()
+        );
+        assert!((ratio / ideal - 1.0).abs() < 0.06, "{ratio} vs {ideal}");
+        mean += 0.5 * ratio;
+    }
+    // turning left the second axle turns 2 % short of Ackermann's, turning right 5 % past:
+    // on average within 1.5 %
+    let ideal = (spec.axles[1].x - x_rear) / (spec.axles[0].x - x_rear);
+    assert!((mean / ideal - 1.0).abs() < 0.02, "{mean} vs {ideal}");
 }
 
 #[test]
@@ -222,10 +270,10 @@ fn parallel_steer_by_hand() {
 
 /// The engine turns the wheels by the linkage's angles: after the steering has slewed to an
 /// input, each steered wheel's angle is the closed form's within 1e-5 rad (the engine
-/// interpolates a table of 400 intervals, see `Model::linkage_table`).
+/// interpolates a table of 400 intervals, see `Model::linkage_tables`).
 #[test]
 fn the_engine_steers_by_the_linkage() {
-    for name in ["gator", "sedan", "uaz", "artcar"] {
+    for name in ["gator", "sedan", "uaz", "artcar", "truck8"] {
         let spec = vehicles::builtin(name).unwrap();
         let l = spec.steering.linkage.unwrap();
         let world = verti_sim::testing::flat_world(spec.scale, 0.8);
@@ -239,12 +287,45 @@ fn the_engine_steers_by_the_linkage() {
                 sim.step(&mut st, verti_sim::Controls::new(0.0, 1.0, u), 0.01)
                     .unwrap();
             }
-            let (left, right) = wheel_angles(&l, u).unwrap();
-            let (a, b) = (st.wheels()[0].steer_angle, st.wheels()[1].steer_angle);
-            assert!(
-                (a - left).abs() < 1e-5 && (b - right).abs() < 1e-5,
-                "{name} at {u}: engine {a} / {b}, linkage {left} / {right}"
-            );
+            // each steered axle by its own linkage (the truck8's second axle: wheels 2, 3)
+            let mut axles = vec![(0, l)];
+            if let Some(second) = spec.axles[1].linkage {
+                axles.push((2, second));
+            }
+            for (w, l) in axles {
+                let (left, right) = wheel_angles(&l, u).unwrap();
+                let (a, b) = (st.wheels()[w].steer_angle, st.wheels()[w + 1].steer_angle);
+                assert!(
+                    (a - left).abs() < 1e-5 && (b - right).abs() < 1e-5,
+                    "{name} at {u}, wheels {w}, {}: engine {a} / {b}, linkage {left} / {right}",
+                    w + 1
+                );
+            }
         }
+    }
+}
+
+/// With linkage steering every steered axle after the first gives its own linkage, and no other
+/// axle does; the error names the axle's field.
+#[test]
+fn per_axle_linkages_are_checked_by_name() {
+    let spec = vehicles::builtin("truck8").unwrap();
+    let mut missing = spec.clone();
+    missing.axles[1].linkage = None;
+    let mut extra = spec.clone();
+    extra.axles[2].linkage = spec.axles[1].linkage;
+    let mut bad_point = spec.clone();
+    bad_point.axles[1].linkage.as_mut().unwrap().steering_arm = [-0.2, -0.8];
+    for (edited, field) in [
+        (missing, "axles[1].linkage"),
+        (extra, "axles[2].linkage"),
+        (bad_point, "axles[1].linkage.steering_arm"),
+    ] {
+        let text = edited.to_yaml();
+        let msg = verti_sim::VehicleSpec::from_yaml_str(&text, "truck8-edit")
+            .unwrap_err()
+            .to_string();
+        println!("{msg}");
+        assert!(msg.contains(&format!("field `{field}`")), "{msg}");
     }
 }
