@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """VertiAdaptor's Table IV on 150 tasks (docs/src/results/vertiadaptor.md) from the committed
-1000-task runs: the 10 tasks of the first five verti-100 worlds of each elevation level, as
-the page lists them, cut out of benchmarks/verti-100/{va,va-every,va-rls,pid,tal} and
-summarised by `verti report` (the same statistics as any report: success, and the mean and
+runs: the 10 tasks of the first five verti-100 worlds of each elevation level, as the page
+lists them, cut out of benchmarks/verti-100/{va,va-every,va-rls,pid,tal} (1000 tasks each) and
+benchmarks/va-nav/maml (MAML*'s run of these 150), and summarised by `verti report` (the same statistics as any report: success, and the mean and
 population variance across trials of the traversal time and of each trial's mean |roll| and
 |pitch|).
 
@@ -27,7 +27,14 @@ TASKS = {
     "mid": "51-60,71-80,91-100,111-130",
     "high": "21-30,81-90,191-220",
 }
-VARIANTS = [("va", "VA* (once)"), ("va-every", "VA† (every 5 s)"), ("va-rls", "VA-RLS")]
+VARIANTS = [
+    ("va", "VA* (once)"),
+    ("va-every", "VA† (every 5 s)"),
+    ("va-rls", "VA-RLS"),
+    ("maml", "MAML* (once)"),
+]
+# where each run is: the 1000-task runs of verti-100, and MAML*'s own 150-task run
+SOURCES = {"maml": "benchmarks/va-nav/maml"}
 BESIDE = [("pid", "PID (same tasks)"), ("tal", "TAL (same tasks)")]
 
 
@@ -46,7 +53,7 @@ def summaries(verti, runs, tmp, fig=None):
     tasks = task_set()
     dirs = []
     for name in runs:
-        src = ROOT / "benchmarks" / "verti-100" / name
+        src = ROOT / SOURCES.get(name, f"benchmarks/verti-100/{name}")
         dst = tmp / name
         dst.mkdir()
         shutil.copy(src / "run.json", dst / "run.json")
@@ -60,7 +67,7 @@ def summaries(verti, runs, tmp, fig=None):
     ).stdout
     if fig:
         out = tmp / "report"
-        variants = dirs[: len(VARIANTS)]
+        variants = dirs[: len(VARIANTS)]  # the VertiAdaptor variants and MAML*
         subprocess.run(
             [verti, "report", "--out", str(out), *variants], check=True, capture_output=True
         )
