@@ -9,8 +9,11 @@
 //! tangent point round to 50° above the horizontal. Every profile point has its outward normal
 //! `n`; the track's surface there moves along `(n_z, −n_x)` relative to the hull at the road
 //! wheels' rim speed (a loop turning the same way everywhere: backward along the bottom, down
-//! the front run, up the rear one). The profile repeats on two lines across the track, at a
-//! quarter of its width either side of its centre (each line stands for half the width).
+//! the front run, up the rear one). Between neighbouring road wheels the track spans their
+//! common tangent, a little inside it ([`SPAN_INSET`]), so that it carries the vehicle only
+//! where something pokes up between two road wheels. The profile repeats on two lines across
+//! the track, at a quarter of its width either side of its centre (each line stands for half
+//! the width).
 
 use crate::spec::VehicleSpec;
 use verti_core::Vec3;
