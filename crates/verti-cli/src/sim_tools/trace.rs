@@ -27,8 +27,8 @@ pub fn traced_world(arg: &str, scale: f64) -> Result<Arc<World>, verti_world::er
 }
 
 /// One line of a trace: time, centre of mass, roll/pitch/yaw in degrees, speed, the controls,
-/// the contact counts (chassis-terrain, chassis-obstacle, wheel-obstacle, soil nodes) and each
-/// wheel's normal force / spring compression / spin rate.
+/// the contact counts (chassis-terrain, chassis-obstacle, wheel-obstacle, soil nodes, points of
+/// a track's raised ends) and each wheel's normal force / spring compression / spin rate.
 pub fn trace_line(st: &SimState, c: &Controls) -> String {
     let p = st.com_position();
     let (r, pi, y) = st.euler();
@@ -44,7 +44,7 @@ pub fn trace_line(st: &SimState, c: &Controls) -> String {
         .collect();
     let ct = st.contacts();
     format!(
-        "t {:6.2} p ({:7.2} {:7.2} {:6.2}) rpy ({:6.1} {:6.1} {:6.1}) |v| {:7.2} c {:.2}/{:.2}/{:.2} cont ({} {} {} {}) w {}",
+        "t {:6.2} p ({:7.2} {:7.2} {:6.2}) rpy ({:6.1} {:6.1} {:6.1}) |v| {:7.2} c {:.2}/{:.2}/{:.2} cont ({} {} {} {} {}) w {}",
         st.time(),
         p.x,
         p.y,
@@ -60,6 +60,7 @@ pub fn trace_line(st: &SimState, c: &Controls) -> String {
         ct.chassis_obstacle_points,
         ct.wheel_obstacle_contacts,
         ct.soil_nodes_in_contact,
+        ct.track_run_points,
         wheels.join(" ")
     )
 }
