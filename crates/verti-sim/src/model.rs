@@ -306,12 +306,8 @@ impl Model {
             .iter()
             .any(|w| w.coupling.is_some_and(|c| c.beam.is_some()));
         let soil_floor = 2.0 * wheels.iter().map(|w| w.radius).fold(0.0, f64::max);
-        let wheel_xy: Vec<(f64, f64)> = (0..wheels.len())
-            .map(|w| {
-                let side = if w % 2 == 0 { 1.0 } else { -1.0 };
-                (spec.axles[w / 2].x, side * 0.5 * spec.axles[w / 2].track)
-            })
-            .collect();
+        // each wheel's (x, y) in the reference frame
+        let wheel_xy: Vec<(f64, f64)> = wheels.iter().map(|m| (m.attach.x + com.x, m.y)).collect();
         let track_runs = TrackRuns::compile(
             spec,
             com,

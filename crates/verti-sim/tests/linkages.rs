@@ -108,9 +108,6 @@ fn artcar_pitman_arm() {
     );
 }
 
-/// With the arms straight back and the tie rods across (parallel steer) both wheels turn alike
-/// while the rods' angularity is small, as sin δ = travel / arm by hand; and the bicycle angle
-/// of two different wheel angles lies between them.
 // The truck6's rotary arm and bellcrank (Chrono's MAN 7t): the derivation's angles, and the
 // same chain solved another way, as three sets of distance constraints by bisection (the drag
 // link's, then each tie rod's length kept), to 1e-9 rad.
@@ -208,15 +205,15 @@ fn truck8_two_rotary_arms_and_bellcranks() {
     let second = spec.axles[1].linkage.unwrap();
     bellcrank_by_bisection(&first);
     bellcrank_by_bisection(&second);
+    // ideal: both axles' centre lines point at one turn centre on the rear bogie's line,
+    // tan δ2 / tan δ1 = (x2 − x_rear) / (x1 − x_rear)
     let x_rear = 0.5 * (spec.axles[2].x + spec.axles[3].x);
+    let ideal = (spec.axles[1].x - x_rear) / (spec.axles[0].x - x_rear);
     let mut mean = 0.0;
     for u in [1.0, -1.0] {
         let (l1, r1) = wheel_angles(&first, u).unwrap();
         let (l2, r2) = wheel_angles(&second, u).unwrap();
         let (b1, b2) = (bicycle_angle(l1, r1), bicycle_angle(l2, r2));
-        // ideal: both axles' centre lines point at one turn centre on the rear bogie's line,
-        // tan δ2 / tan δ1 = (x2 − x_rear) / (x1 − x_rear)
-        let ideal = (spec.axles[1].x - x_rear) / (spec.axles[0].x - x_rear);
         let ratio = b2.tan() / b1.tan();
         println!(
             "truck8 input {u}: first axle {:.2}° / {:.2}° (bicycle {:.2}°), second {:.2}° / \
@@ -233,10 +230,12 @@ fn truck8_two_rotary_arms_and_bellcranks() {
     }
     // turning left the second axle turns 2 % short of Ackermann's, turning right 5 % past:
     // on average within 1.5 %
-    let ideal = (spec.axles[1].x - x_rear) / (spec.axles[0].x - x_rear);
     assert!((mean / ideal - 1.0).abs() < 0.02, "{mean} vs {ideal}");
 }
 
+/// With the arms straight back and the tie rods across (parallel steer) both wheels turn alike
+/// while the rods' angularity is small, as sin δ = travel / arm by hand; and the bicycle angle
+/// of two different wheel angles lies between them.
 #[test]
 fn parallel_steer_by_hand() {
     let arm = 0.15f64;

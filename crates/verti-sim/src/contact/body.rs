@@ -5,6 +5,7 @@
 //! bottom face that stand above the ground the lattice sees ([`super::belly`]).
 
 use crate::contact::belly::{Push, belly_contacts};
+use crate::contact::body_ground;
 use crate::friction::{OBSTACLE_FRICTION, body_friction, surface_mu};
 use crate::integrate::Loads;
 use crate::model::Model;
@@ -82,17 +83,8 @@ pub(crate) fn body_contacts(
                 continue;
             }
             let surface = &patches[terrain.ground.patch_index(p.x, p.y)].surface;
-            // Soil does not hold the chassis up: in Chrono's SCM only the wheels (the bodies with
-            // an active domain) meet the soil, and the chassis passes through it. Holding it at
-            // the undeformed surface instead left verti's HMMWV high-centred on snow wherever its
-            // wheels sank 0.2-0.4 m, stuck where Chrono's drives on (issue 34). A floor one wheel
-            // diameter below the surface remains, which no upright vehicle reaches while its
-            // wheels carry it: it keeps a capsized vehicle from falling through the map, as
-            // Chrono's can (a reference artifact, not physics).
-            let h = match surface {
-                verti_world::Surface::Deformable { .. } => h - model.soil_floor,
-                verti_world::Surface::Rigid { .. } => h,
-            };
+            // soil holds the chassis only at a floor far below its surface
+            let h = body_ground(h, surface, model);
             if h <= p.z {
                 continue;
             }

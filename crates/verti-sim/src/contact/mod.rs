@@ -113,6 +113,26 @@ pub(crate) struct RigidContact {
     pub moment: Vec3,
 }
 
+/// The height at which the ground at height `h` holds a part of the vehicle that is not a
+/// wheel (the hull, a track's raised ends): rigid ground at its surface, soil only at a floor
+/// one (largest) wheel diameter below it. In Chrono's SCM only the wheels (the bodies with an
+/// active domain) meet the soil, and the chassis passes through it; holding it at the
+/// undeformed surface instead left verti's HMMWV high-centred on snow wherever its wheels sank
+/// 0.2-0.4 m, stuck where Chrono's drives on (issue 34). No upright vehicle reaches the floor
+/// while its wheels carry it: it keeps a capsized vehicle from falling through the map, as
+/// Chrono's can (a reference artifact, not physics).
+#[inline]
+pub(crate) fn body_ground(
+    h: f64,
+    surface: &verti_world::Surface,
+    model: &crate::model::Model,
+) -> f64 {
+    match surface {
+        verti_world::Surface::Deformable { .. } => h - model.soil_floor,
+        verti_world::Surface::Rigid { .. } => h,
+    }
+}
+
 /// The broad phase of a wheel (radius `r`, half width `half_width`, hub at `hub`) against
 /// obstacle `k`: `None` when the obstacle is out of reach by its planar circle, its height
 /// range or its bounding sphere (cheapest test first), else its fast geometry. Shared by both

@@ -14,6 +14,7 @@
 //! the hull gets exactly the force the spin saw. Soil does not hold the runs: like the hull,
 //! they meet a floor one wheel diameter below a soil surface (`contact::body`).
 
+use crate::contact::body_ground;
 use crate::drivetrain::SpinLoads;
 use crate::friction::{OBSTACLE_FRICTION, surface_mu};
 use crate::integrate::Loads;
@@ -174,22 +175,16 @@ pub(crate) fn track_run_contacts(
                 let p = st.position + arm;
                 if ground_near && p.z < terrain.bound.max_at(p.x, p.y) {
                     let (h, gx, gy) = terrain.ground.sample(p.x, p.y);
-                    let surface = if h > p.z {
-                        Some(&patches[terrain.ground.patch_index(p.x, p.y)].surface)
-                    } else {
-                        None
-                    };
-                    let h = match surface {
-                        Some(verti_world::Surface::Deformable { .. }) => h - model.soil_floor,
-                        _ => h,
-                    };
-                    if let Some(surface) = surface
-                        && h > p.z
-                    {
-                        let mu = surface_mu(surface).min(runs.mu);
-                        let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
-                        let n = Vec3::new(-gx * nz, -gy * nz, nz);
-                        touch(arm, belt, n, (h - p.z) * nz, mu);
+                    // the patch only where the surface reaches the point (a soil floor is lower)
+                    if h > p.z {
+                        let surface = &patches[terrain.ground.patch_index(p.x, p.y)].surface;
+                        let h = body_ground(h, surface, model);
+                        if h > p.z {
+                            let mu = surface_mu(surface).min(runs.mu);
+                            let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
+                            let n = Vec3::new(-gx * nz, -gy * nz, nz);
+                            touch(arm, belt, n, (h - p.z) * nz, mu);
+                        }
                     }
                 }
                 for &k in tested {
