@@ -12,10 +12,10 @@ quotes (α 0.8 against PID and MPPI; α 1 against α 0.5 over all 330 high-eleva
 248 tasks' 165 and the other 165 in `high2-*`).
 """
 
-import json
-import math
 import pathlib
 import sys
+
+from run_rows import paired, rows, share, sign_test, success_by_level
 
 VARIANTS = [
     ("PIETRA, α 0.5 (the default)", "pietra"),
@@ -29,32 +29,14 @@ VARIANTS = [
 
 
 def load(root, name):
-    path = root / name / "results.jsonl"
-    with open(path) as f:
-        return {r["task"]: r for r in map(json.loads, f)}
-
-
-def sign_test(a, b):
-    """Two-sided exact sign test of a wins against b wins."""
-    n = a + b
-    if n == 0:
-        return 1.0
-    k = min(a, b)
-    tail = sum(math.comb(n, i) for i in range(k + 1)) / 2**n
-    return min(1.0, 2 * tail)
+    """{task: result} of one committed run."""
+    return {r["task"]: r for r in rows(root / name)}
 
 
 def wins(x, y):
     """Tasks x reaches and y does not, and the reverse (tasks both ran)."""
-    common = x.keys() & y.keys()
-    ok = lambda r: r["outcome"] == "success"
-    gained = sum(1 for t in common if ok(x[t]) and not ok(y[t]))
-    lost = sum(1 for t in common if ok(y[t]) and not ok(x[t]))
-    return gained, lost
-
-
-def pct(rows, pred):
-    return 100.0 * sum(1 for r in rows if pred(r)) / len(rows)
+    outcome = lambda run: {t: r["outcome"] for t, r in run.items()}
+    return paired(outcome(x), outcome(y))
 
 
 def main():
@@ -67,16 +49,15 @@ def main():
     )
     print("|---|---|---|---|---|---|---|")
     for label, name in VARIANTS:
-        rows = list(runs[name].values())
-        success = lambda r: r["outcome"] == "success"
-        by_level = {lvl: [r for r in rows if r["level"] == lvl] for lvl in ("mid", "high")}
-        high = by_level["high"]
-        speed = sum(r["path_length"] / r["time"] for r in high if r["time"] > 0) / len(high)
+        results = list(runs[name].values())
+        _, mid, high = success_by_level(results)
+        on_high = [r for r in results if r["level"] == "high"]
+        speed = sum(r["path_length"] / r["time"] for r in on_high if r["time"] > 0) / len(on_high)
         cells = [
-            f"{pct(rows, success):.1f} %",
-            f"{pct(by_level['mid'], success):.1f}",
-            f"{pct(high, success):.1f}",
-            f"{pct(rows, lambda r: r['outcome'] == 'rollover'):.1f}",
+            f"{share(results, 'success')} %",
+            mid,
+            high,
+            share(results, "rollover"),
             f"{speed:.2f}",
         ]
         if name == "pietra":
@@ -104,8 +85,8 @@ def main():
     for label, x, y in [("α 1 against α 0.5, high", a1, a05), ("α 1 against PID, high", a1, pid)]:
         g, l = wins(x, y)
         print(
-            f"| {label} ({pct(list(x.values()), lambda r: r['outcome'] == 'success'):.1f} "
-            f"against {pct(list(y.values()), lambda r: r['outcome'] == 'success'):.1f} %) | "
+            f"| {label} ({share(list(x.values()), 'success')} "
+            f"against {share(list(y.values()), 'success')} %) | "
             f"{len(x)} | {g} vs {l} | {sign_test(g, l):.2g} |"
         )
 

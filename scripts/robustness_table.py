@@ -15,6 +15,8 @@ import json
 import sys
 from pathlib import Path
 
+from run_rows import paired
+
 PRESETS = ["none", "low", "medium", "high"]
 SUBSET = set(range(1, 1001, 10))
 # the paper's order, then ours; anything else after them, alphabetically
@@ -45,11 +47,9 @@ def success(path, tasks=None):
 def lost_gained(clean, noisy, tasks=None):
     """Tasks solved without noise and not with it, and the reverse (on tasks both ran)."""
     a, b = outcomes(clean, tasks), outcomes(noisy, tasks)
-    both = a.keys() & b.keys()
-    if not both:
+    if not a.keys() & b.keys():
         return "—"
-    lost = sum(a[t] == "success" and b[t] != "success" for t in both)
-    gained = sum(a[t] != "success" and b[t] == "success" for t in both)
+    lost, gained = paired(a, b)
     return f"{lost} / {gained}"
 
 

@@ -1,7 +1,9 @@
 """Reading committed runs for the documentation's table scripts (method_tables.py,
-vehicles_table.py): the results of a run, and the shares the tables print."""
+vehicles_table.py, pietra_validation_table.py, va_table4.py, robustness_table.py): the results
+of a run, the shares the tables print, and paired comparisons."""
 
 import json
+import math
 from pathlib import Path
 
 LEVELS = ["low", "mid", "high"]
@@ -28,3 +30,21 @@ def share(rs, outcome):
 def success_by_level(rs):
     """Success percentage at each elevation level, formatted, low to high."""
     return [share([r for r in rs if r["level"] == level], "success") for level in LEVELS]
+
+
+def paired(a, b):
+    """Of the tasks both {task: outcome} maps hold: how many only `a` reached and how many only
+    `b` reached."""
+    both = a.keys() & b.keys()
+    only_a = sum(a[t] == "success" and b[t] != "success" for t in both)
+    only_b = sum(a[t] != "success" and b[t] == "success" for t in both)
+    return only_a, only_b
+
+
+def sign_test(a, b):
+    """Two-sided exact sign test of `a` wins against `b` wins."""
+    n = a + b
+    if n == 0:
+        return 1.0
+    tail = sum(math.comb(n, i) for i in range(min(a, b) + 1)) / 2**n
+    return min(1.0, 2 * tail)

@@ -21,6 +21,8 @@ import subprocess
 import sys
 import tempfile
 
+from run_rows import rows
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 TASKS = {
     "low": "1-20,31-50,61-70",
@@ -57,10 +59,9 @@ def summaries(verti, runs, tmp, fig=None):
         dst = tmp / name
         dst.mkdir()
         shutil.copy(src / "run.json", dst / "run.json")
-        with open(src / "results.jsonl") as f, open(dst / "results.jsonl", "w") as out:
-            for line in f:
-                if json.loads(line)["task"] in tasks:
-                    out.write(line)
+        with open(dst / "results.jsonl", "w") as out:
+            for r in rows(src, tasks):
+                out.write(json.dumps(r) + "\n")
         dirs.append(str(dst))
     text = subprocess.run(
         [verti, "report", "--json", *dirs], check=True, capture_output=True, text=True
