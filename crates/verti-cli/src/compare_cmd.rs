@@ -61,6 +61,16 @@ pub struct CompareArgs {
     /// chaos sets on it (the pages show the first run).
     #[arg(long, default_value_t = 1)]
     ensemble: usize,
+    /// Also write verti's trajectory of each task as `verti-world-NNN_pP.csv` in --out, in the
+    /// reference's columns (t, x, y, z, roll, pitch, yaw, v, steer, throttle, brake, agl; agl is
+    /// the chassis position's height above the ground), to set beside the reference's file.
+    #[arg(long)]
+    csv: bool,
+    /// Compare every selected task, including reference trials that record an artifact of the
+    /// reference engine (a chassis more than one wheel diameter below the ground: it fell
+    /// through the soil). By default they are left out of every table and listed.
+    #[arg(long)]
+    keep_artifacts: bool,
     /// Largest start offset of the ensemble's runs, metres.
     #[arg(long, default_value_t = verti_compare::ensemble::DEFAULT_JITTER)]
     jitter: f64,
@@ -103,6 +113,27 @@ pub fn compare(a: CompareArgs) -> CmdResult {
         return Err(format!("--jitter {}: give a distance in (0, 10] metres", a.jitter).into());
     }
     let refs: Vec<&RefTask> = chosen.iter().map(|&i| &reference.tasks[i]).collect();
+    let (refs, excluded) = if a.keep_artifacts {
+        (refs, Vec::new())
+    } else {
+        let diameter = 2.0
+            * setup
+                .vehicle
+                .axles
+                .iter()
+                .map(|x| x.wheel.radius)
+                .fold(0.0, f64::max);
+        verti_compare::artifact::split_artifacts(refs, diameter)
+    };
+    for x in &excluded {
+        eprintln!(
+            "left out {} pair {} ({}): {} (--keep-artifacts compares it)",
+            x.world, x.pair, x.ground, x.reason
+        );
+    }
+    if refs.is_empty() {
+        return Err("every selected reference trial was left out as an artifact (--keep-artifacts compares them)".into());
+    }
     let worlds = load_worlds(
         &a.vb_worlds,
         &a.reference,
@@ -137,6 +168,11 @@ pub fn compare(a: CompareArgs) -> CmdResult {
                 .with_extension("png");
             verti_render::comparison_png(&worlds[&o.world_index], &page, &out)
                 .map_err(|e| e.to_string())?;
+            if a.csv {
+                let name = verti_compare::reference::trajectory_file_name(o.world_index, o.pair);
+                let text = verti_compare::reference::format_trajectory(&run.samples);
+                write(&a.out.join(format!("verti-{name}")), &text)?;
+            }
             pb.inc(1);
             Ok(())
         })?;
@@ -148,6 +184,7 @@ pub fn compare(a: CompareArgs) -> CmdResult {
         .map(|(r, run)| compare_task(r, run))
         .collect();
     let mut summary = summarize(&setup, &engine, comparisons);
+    summary.excluded = excluded;
     if a.ensemble > 1 {
         let members: Vec<_> = summary
             .tasks

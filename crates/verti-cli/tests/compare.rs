@@ -135,3 +135,55 @@ fn bad_references_and_options_get_clear_errors() {
     assert!(e.contains("world-009_p0.csv"), "{e}");
     let _ = std::fs::remove_dir_all(&bad);
 }
+
+/// The snow trial whose reference chassis falls through the soil is left out and listed, unless
+/// asked for; `--csv` writes verti's trajectory in the reference's columns, readable back.
+#[test]
+fn a_fall_through_is_left_out_and_csv_trajectories_are_written() {
+    let Some(shared) = shared() else { return };
+    let soil = shared.join("chrono-reference/soil");
+    let out = tmp("artifact");
+    let o = out.to_str().unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "sim",
+            "compare",
+            soil.to_str().unwrap(),
+            "--tasks",
+            "83:3,83:2",
+        ];
+        args.extend_from_slice(&["--json", "--out", o]);
+        args.extend_from_slice(extra);
+        let (ok, stdout, stderr) = verti(&repo_root(), &args);
+        assert!(ok, "{stderr}");
+        let summary: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        (summary, stderr)
+    };
+    let (summary, stderr) = run(&["--csv"]);
+    assert!(
+        stderr.contains("left out vb/config83_mid pair 3 (snow): the chassis falls through"),
+        "{stderr}"
+    );
+    assert_eq!(summary["groups"][0]["tasks"], 1);
+    assert_eq!(summary["excluded"][0]["pair"], 3);
+    assert_eq!(summary["excluded"][0]["reference_outcome"], "rollover");
+    let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(md.contains("## Left out: 1 reference trial"), "{md}");
+    let csv = std::fs::read_to_string(out.join("verti-world-083_p2.csv")).unwrap();
+    assert!(
+        csv.starts_with("t,x,y,z,roll,pitch,yaw,v,steer,throttle,brake,agl\n"),
+        "{}",
+        &csv[..80]
+    );
+    let samples = verti_compare::reference::parse_trajectory(&csv, &out).unwrap();
+    assert!(samples.len() > 100 && samples.iter().all(|s| s.agl.is_finite()));
+    assert!(
+        !out.join("verti-world-083_p3.csv").exists(),
+        "left out, not run"
+    );
+
+    let (summary, _) = run(&["--keep-artifacts"]);
+    assert_eq!(summary["groups"][0]["tasks"], 2);
+    assert_eq!(summary["excluded"].as_array().unwrap().len(), 0);
+    let _ = std::fs::remove_dir_all(&out);
+}

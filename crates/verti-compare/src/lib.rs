@@ -5,6 +5,8 @@
 //!
 //! * [`reference`](mod@reference): reading the reference's `outcomes.jsonl` and 10 Hz trajectory files.
 //! * [`select`]: which reference tasks to compare (`--tasks`).
+//! * [`artifact`]: reference trials that record an artifact of the reference engine (a chassis
+//!   falling through the soil), left out and listed rather than taken as a target.
 //! * [`run`]: the verti side, set up as the reference describes ([`CompareSetup`]: world with
 //!   one rigid surface everywhere, PID with the reference's steering law), run in parallel and
 //!   deterministically.
@@ -19,6 +21,7 @@
 //! Everything takes and returns plain data; drawing is left to `verti-render` and the command
 //! line to `verti-cli` (`verti sim compare`).
 
+pub mod artifact;
 pub mod divergence;
 pub mod driver;
 pub mod ensemble;

@@ -137,6 +137,24 @@ pub fn markdown(s: &Summary) -> String {
             num(a.whole.max_roll_error, 1),
         );
     }
+    if !s.excluded.is_empty() {
+        let _ = writeln!(
+            out,
+            "\n## Left out: {} reference trial(s) recording an artifact of {r}, not physics\n\nNot counted in any table.\n\n| world | pair | ground | {r}'s outcome | why |\n|---|---:|---|---|---|",
+            s.excluded.len()
+        );
+        for x in &s.excluded {
+            let _ = writeln!(
+                out,
+                "| {} | {} | {} | {} | {} |",
+                x.world,
+                x.pair,
+                x.ground,
+                x.reference_outcome.name(),
+                x.reason
+            );
+        }
+    }
     if let Some(e) = &s.ensemble {
         ensemble(&mut out, &r, e);
     }

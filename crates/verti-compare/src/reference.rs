@@ -291,6 +291,37 @@ const REQUIRED_COLUMNS: [&str; 7] = ["t", "x", "y", "z", "roll", "pitch", "yaw"]
 /// Columns read when present.
 const OPTIONAL_COLUMNS: [&str; 5] = ["v", "steer", "throttle", "brake", "agl"];
 
+/// A sample's values in the order of [`REQUIRED_COLUMNS`] then [`OPTIONAL_COLUMNS`].
+fn sample_values(s: &Sample) -> [f64; 12] {
+    [
+        s.t, s.x, s.y, s.z, s.roll, s.pitch, s.yaw, s.v, s.steer, s.throttle, s.brake, s.agl,
+    ]
+}
+
+/// `samples` as a trajectory CSV that [`parse_trajectory`] reads back: the required columns and
+/// every optional one that has a number in each sample (a column with a gap would not read).
+pub fn format_trajectory(samples: &[Sample]) -> String {
+    let names: Vec<&str> = REQUIRED_COLUMNS
+        .iter()
+        .chain(&OPTIONAL_COLUMNS)
+        .copied()
+        .collect();
+    let keep: Vec<usize> = (0..names.len())
+        .filter(|&k| {
+            k < REQUIRED_COLUMNS.len() || samples.iter().all(|s| sample_values(s)[k].is_finite())
+        })
+        .collect();
+    let mut out = keep.iter().map(|&k| names[k]).collect::<Vec<_>>().join(",");
+    out.push('\n');
+    for s in samples {
+        let v = sample_values(s);
+        let row: Vec<String> = keep.iter().map(|&k| format!("{:.4}", v[k])).collect();
+        out.push_str(&row.join(","));
+        out.push('\n');
+    }
+    out
+}
+
 /// Reads a trajectory file (see [`parse_trajectory`]).
 pub fn read_trajectory(path: &Path) -> Result<Vec<Sample>> {
     parse_trajectory(&read_text(path)?, path)
@@ -430,6 +461,22 @@ mod tests {
                 .starts_with("ref/outcomes.jsonl:1: not a JSON object")
         );
         assert!(msg(parse_outcomes("\n\n", p)).contains("no reference tasks"));
+    }
+
+    #[test]
+    fn a_written_trajectory_reads_back_without_its_incomplete_columns() {
+        let p = Path::new("verti-world-002_p3.csv");
+        let mut a = Sample::pose(0.1, 1.0, 2.0, 3.5, -4.25);
+        (a.z, a.yaw, a.v, a.agl) = (4.0, 30.0, 2.5, 0.9);
+        let mut b = Sample::pose(0.2, 1.5, 2.25, 3.0, -4.0);
+        (b.z, b.yaw, b.v) = (4.125, 31.0, 2.75);
+        let text = format_trajectory(&[a, b]);
+        assert!(text.starts_with("t,x,y,z,roll,pitch,yaw,v\n"), "{text}");
+        let back = parse_trajectory(&text, p).unwrap();
+        assert_eq!(back.len(), 2);
+        assert_eq!((back[1].t, back[1].y, back[1].pitch), (0.2, 2.25, -4.0));
+        assert_eq!((back[0].v, back[1].v), (2.5, 2.75));
+        assert!(back[0].agl.is_nan(), "agl has a gap, so it is left out");
     }
 
     #[test]

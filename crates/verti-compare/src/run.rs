@@ -317,10 +317,11 @@ pub fn run_task(world: &Arc<World>, pair: u32, setup: &CompareSetup) -> VertiRun
         &setup.episode,
         Some(&mut log),
     );
-    VertiRun {
-        result,
-        samples: resample(&log.steps, SAMPLE_PERIOD),
+    let mut samples = resample(&log.steps, SAMPLE_PERIOD);
+    for s in &mut samples {
+        s.agl = s.z - world.terrain.height_at(s.x, s.y);
     }
+    VertiRun { result, samples }
 }
 
 /// Runs `tasks` (world index, pair) on `jobs` threads; the results are in the order of

@@ -268,6 +268,9 @@ pub struct Summary {
     /// The grounds the tasks were run on, in order of first appearance.
     pub grounds: Vec<String>,
     pub tasks: Vec<TaskComparison>,
+    /// Reference trials left out as artifacts of the reference engine
+    /// ([`crate::artifact`]); not in `tasks` or any group.
+    pub excluded: Vec<crate::artifact::Excluded>,
     /// Each task re-run from jittered starts (`--ensemble`), when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ensemble: Option<crate::ensemble::Ensemble>,
@@ -302,6 +305,7 @@ pub fn summarize(setup: &CompareSetup, engine: &str, tasks: Vec<TaskComparison>)
         groups,
         grounds,
         tasks,
+        excluded: Vec::new(),
         ensemble: None,
     }
 }
