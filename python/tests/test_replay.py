@@ -47,3 +47,17 @@ def test_rrd_verifies_with_rerun_tooling(run_dir, tmp_path):
     printed = subprocess.run([rerun, "rrd", "print", "-v", str(rrd)], capture_output=True, text=True, env=env)
     for entity in ("/world/terrain", "/world/vehicle/body", "/world/vehicle/wheels", "/plots/speed", "/plots/sinkage_cm"):
         assert entity in printed.stdout, entity
+
+
+def test_a_run_on_worlds_in_memory_replays_with_the_same_worlds(tmp_path):
+    """A run made on a list of World objects records no set name: replay says how to pass the
+    worlds, replays with them, and refuses other worlds."""
+    worlds = verti.load_worlds("verti-3")
+    run = tmp_path / "run"
+    rows = verti.evaluate("pid", worlds, tasks="1", out=str(run))
+    with pytest.raises(ValueError, match=r"3 worlds.*worlds="):
+        verti.replay(run, 1, tmp_path / "a.html")
+    result = verti.replay(run, 1, tmp_path / "a.html", worlds=worlds)
+    assert result["outcome"] == rows[0]["outcome"] and result["time"] == rows[0]["time"]
+    with pytest.raises(ValueError, match="not those the run"):
+        verti.replay(run, 1, tmp_path / "b.html", worlds=verti.load_worlds("verti-3-s1"))

@@ -524,10 +524,13 @@ def systems() -> list[dict[str, Any]]:
     """The systems that ``evaluate`` knows, with their parameters (name, type, default, min and
     max or choices, doc)."""
 
-def _replay(run: _StrPath, task: int, out: _StrPath) -> dict[str, Any]:
+def _replay(
+    run: _StrPath, task: int, out: _StrPath, worlds: _WorldsArg | None = None
+) -> dict[str, Any]:
     """Re-runs task ``task`` of the run in directory ``run`` and writes its 3-D recording to
-    ``out`` (``.html``: a self-contained page; ``.json``: the recording itself). Returns the
-    replayed trial's result dict; warns if it ended otherwise than the recorded one."""
+    ``out`` (``.html``: a self-contained page; ``.json``: the recording itself). ``worlds``
+    replaces the world set the run names (checked by content). Returns the replayed trial's
+    result dict; warns if it ended otherwise than the recorded one."""
 
 def _load_dataset(path: _StrPath) -> tuple[dict[str, NDArray[Any] | list[str | None]], str]:
     """Loads the dataset in ``path``: (dict of column name -> numpy array, in schema order; the

@@ -40,12 +40,15 @@ impl ReplaySetup {
 /// Reads `dir/run.json` and the result of `task`, and rebuilds its world (from the run's set,
 /// checked by content), vehicle (the recorded spec, checked by digest) and system (from
 /// `registry` with the recorded parameters). `vehicle_by_name` loads a vehicle for runs
-/// recorded before specs were kept.
+/// recorded before specs were kept. `worlds`, when given, is the run's world set itself (also
+/// checked by content): a run made on worlds held in memory (`verti.evaluate` on a list of
+/// `World`s) records only a label such as `100 worlds`, which no name resolves.
 pub fn prepare(
     dir: &Path,
     task: u32,
     registry: &SystemRegistry,
     vehicle_by_name: &dyn Fn(&str) -> Result<VehicleSpec, String>,
+    worlds: Option<Vec<Arc<World>>>,
 ) -> Result<ReplaySetup, String> {
     let run_path = dir.join(RUN_FILE);
     let record = RunRecord::read(&run_path).map_err(|e| e.to_string())?;
@@ -77,20 +80,37 @@ pub fn prepare(
     }
     let id = TaskId::from_number(task).ok_or("task numbers start at 1")?;
     // the whole set, to check by content that it is still the set the run used
-    let set: Vec<Arc<World>> = verti_world::sets::resolve_set(&run.worlds, run.scale, &|| {})
-        .map_err(|e| format!("the run's world set `{}`: {e}", run.worlds))?
-        .worlds
-        .into_iter()
-        .map(Arc::new)
-        .collect();
+    let given = worlds.is_some();
+    let set: Vec<Arc<World>> = match worlds {
+        Some(set) => set,
+        None => verti_world::sets::resolve_set(&run.worlds, run.scale, &|| {})
+            .map_err(|e| {
+                format!(
+                    "the run's world set `{}`: {e}; a run made on worlds held in memory is replayed by passing the same worlds (verti.replay(..., worlds=...), verti replay --worlds SET)",
+                    run.worlds
+                )
+            })?
+            .worlds
+            .into_iter()
+            .map(Arc::new)
+            .collect(),
+    };
     if let Some(d) = &record.worlds_digest
         && *d != crate::run::identity::set_digest(&set)
     {
-        return Err(format!(
-            "`{}` no longer holds the worlds the run in {} used (their contents differ); replay where the run was made, or restore the set",
-            run.worlds,
-            dir.display()
-        ));
+        return Err(if given {
+            format!(
+                "the worlds given are not those the run in {} used (`{}`: their contents differ)",
+                dir.display(),
+                run.worlds
+            )
+        } else {
+            format!(
+                "`{}` no longer holds the worlds the run in {} used (their contents differ); replay where the run was made, or restore the set",
+                run.worlds,
+                dir.display()
+            )
+        });
     }
     let world = set
         .iter()

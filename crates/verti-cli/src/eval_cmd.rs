@@ -373,6 +373,11 @@ pub struct ReplayArgs {
     /// Pixels per heightfield cell.
     #[arg(long, default_value_t = 4)]
     px_per_cell: u32,
+    /// The run's world set (as `verti eval --worlds`), checked by content against the run's
+    /// record; by default the set the run names. Needed for a run made on worlds held in memory
+    /// (`verti.evaluate` on a list of worlds), whose record names no set.
+    #[arg(long)]
+    worlds: Option<String>,
 }
 
 /// Re-runs one task of an evaluation (trials are deterministic) with a per-step log and draws
@@ -380,7 +385,18 @@ pub struct ReplayArgs {
 pub fn replay(a: ReplayArgs) -> CmdResult {
     let registry = crate::registries::systems();
     let by_name = |name: &str| load_vehicle(name).map_err(|e| e.to_string());
-    let mut setup = verti_bench::replay::prepare(&a.result, a.task, &registry, &by_name)?;
+    let worlds = match &a.worlds {
+        Some(spec) => Some(
+            verti_world::sets::resolve_set(spec, 1.0, &|| {})
+                .map_err(|e| format!("--worlds {spec}: {e}"))?
+                .worlds
+                .into_iter()
+                .map(std::sync::Arc::new)
+                .collect(),
+        ),
+        None => None,
+    };
+    let mut setup = verti_bench::replay::prepare(&a.result, a.task, &registry, &by_name, worlds)?;
     let (world, vehicle, pair) = (setup.world.clone(), setup.vehicle.clone(), setup.pair);
     let ext = a.out.extension().and_then(|e| e.to_str()).unwrap_or("");
     let three_d_file = ext == "html" || ext == "json";

@@ -136,6 +136,28 @@ fn a_resume_checks_worlds_and_vehicle_by_content() {
         Some(&b),
     );
     assert!(e.contains("no longer holds the worlds"), "{e}");
+    // --worlds hands replay the set itself, checked by content: the same worlds elsewhere replay
+    let c = root.join("c");
+    std::fs::create_dir_all(&c).unwrap();
+    generate(&c.join("w"), "1", &[]);
+    let replay = |worlds: &Path| {
+        vec![
+            "replay".to_string(),
+            out_s.to_string(),
+            "--task".into(),
+            "1".into(),
+            "--out".into(),
+            png.to_str().unwrap().into(),
+            "--worlds".into(),
+            worlds.to_str().unwrap().into(),
+        ]
+    };
+    let args = replay(&c.join("w"));
+    let (said, _) = ok(&args.iter().map(String::as_str).collect::<Vec<_>>(), None);
+    assert!(said.contains("trajectory written"), "{said}");
+    let args = replay(&b.join("w"));
+    let e = err(&args.iter().map(String::as_str).collect::<Vec<_>>(), None);
+    assert!(e.contains("the worlds given are not those the run"), "{e}");
 }
 
 #[test]

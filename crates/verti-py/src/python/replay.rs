@@ -7,21 +7,28 @@ use super::*;
 /// HTML page (terrain, obstacles, vehicle body and wheels, path, trail, time series). Returns
 /// the replayed trial's result dict; warns if it ended otherwise than the recorded one.
 /// A `.json` output gets the recording itself (what `verti.rerun` converts to Rerun's format).
+/// `worlds` (a World, a list of Worlds or a set name) replaces the set the run names, checked
+/// by content: needed for a run made on worlds held in memory.
 #[pyfunction]
-#[pyo3(signature = (run, task, out))]
+#[pyo3(signature = (run, task, out, worlds = None))]
 pub(super) fn _replay(
     py: Python<'_>,
     run: PathBuf,
     task: u32,
     out: PathBuf,
+    worlds: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Py<PyAny>> {
     verti_core::output::check_output_file(&out, &["html", "json"])
         .map_err(|p| value_err(format!("{}: {p}", out.display())))?;
     let as_json = out.extension().and_then(|e| e.to_str()) == Some("json");
     let registry = system_registry();
     let by_name = |name: &str| vehicle_spec(name).map_err(|e| e.to_string());
+    let worlds = match worlds {
+        Some(w) if !w.is_none() => Some(worlds_arg(py, w, None)?.0),
+        _ => None,
+    };
     let mut setup =
-        verti_bench::replay::prepare(&run, task, &registry, &by_name).map_err(value_err)?;
+        verti_bench::replay::prepare(&run, task, &registry, &by_name, worlds).map_err(value_err)?;
     let cancel = AtomicBool::new(false);
     let (recording, replayed) = interruptible(py, &cancel, || {
         verti_view::record_trial(
