@@ -2,7 +2,7 @@
 //! loading world sets and vehicles. It sits below every `*_cmd` module so that commands never
 //! import each other for these helpers (see `scripts/check_layers.py`).
 
-use crate::progress::bar;
+use crate::progress::counter;
 use clap::Args;
 use verti_sim::VehicleSpec;
 use verti_world::WorldError;
@@ -70,8 +70,17 @@ pub fn load_set_with_progress(
     scale: f64,
 ) -> Result<verti_world::sets::WorldSet, WorldError> {
     note_shadowed(spec);
-    let pb = bar(0, "loading");
+    let pb = counter("loading", "worlds");
     let set = resolve_set(spec, scale, &|| pb.inc(1));
     pb.finish_and_clear();
     set
+}
+
+/// `1 task`, `2 tasks`: a count with its noun, singular for one.
+pub fn count(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
 }

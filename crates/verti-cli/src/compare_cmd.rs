@@ -222,11 +222,11 @@ pub fn compare(a: CompareArgs) -> CmdResult {
     }
     let simulated: f64 = runs.iter().map(|r| r.result.time).sum();
     eprintln!(
-        "{} tasks, {:.0} s simulated in {:.1} s on {} jobs ({:.1} s in all); pages, summary.md and summary.json in {}",
-        runs.len(),
+        "{}, {:.0} s simulated in {:.1} s on {} ({:.1} s in all); pages, summary.md and summary.json in {}",
+        crate::cli_common::count(runs.len(), "task"),
         simulated,
         run_seconds,
-        jobs,
+        crate::cli_common::count(jobs, "job"),
         t0.elapsed().as_secs_f64(),
         a.out.display()
     );

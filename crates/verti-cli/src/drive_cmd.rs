@@ -174,8 +174,14 @@ fn run_session(
         script.drive(&mut session);
         return Ok(session.finish());
     }
-    let listener = std::net::TcpListener::bind(("127.0.0.1", a.port))
-        .map_err(|e| format!("--port {}: cannot listen on 127.0.0.1: {e}", a.port))?;
+    let listener = std::net::TcpListener::bind(("127.0.0.1", a.port)).map_err(|e| {
+        let hint = if e.kind() == std::io::ErrorKind::AddrInUse {
+            " (another program uses it: pass another --port, or --port 0 for any free one)"
+        } else {
+            ""
+        };
+        format!("--port {}: cannot listen on 127.0.0.1: {e}{hint}", a.port)
+    })?;
     let addr = listener.local_addr()?;
     // Ctrl-C, SIGTERM (a supervisor, `kill`) and SIGHUP (the terminal closed) end the session
     // like the page's Stop button: what was driven is saved. Installed before the address is

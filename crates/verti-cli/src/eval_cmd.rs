@@ -320,12 +320,12 @@ fn eval_system(
     let count = |o: Outcome| results.iter().filter(|r| r.outcome == o).count();
     let n = results.len().max(1) as f64;
     let mut lines = vec![format!(
-        "{} on {} with {} ({} tasks, {} jobs, {:.1} s): success {:.1}%  rollover {:.1}%  stuck {:.1}%  timeout {:.1}%  error {:.1}%",
+        "{} on {} with {} ({}, {}, {:.1} s): success {:.1}%  rollover {:.1}%  stuck {:.1}%  timeout {:.1}%  error {:.1}%",
         system,
         sh.set_name,
         vehicle.name,
-        results.len(),
-        jobs,
+        crate::cli_common::count(results.len(), "task"),
+        crate::cli_common::count(jobs, "job"),
         wall,
         100.0 * count(Outcome::Success) as f64 / n,
         100.0 * count(Outcome::Rollover) as f64 / n,
