@@ -89,6 +89,18 @@ pub(crate) struct SpinGroup {
     pub driven: bool,
 }
 
+/// A differential's clutch between two sets of wheels (`Differential::Clutch`): it holds the
+/// mean spins of the two sets equal while that takes at most `capacity` and slips beyond it.
+/// Its torque goes in equal parts to the wheels of one set and out of the other's.
+#[derive(Clone, Debug)]
+pub(crate) struct Coupling {
+    /// Each side's spin groups, with how many of the side's wheels each holds.
+    pub a: Vec<(usize, f64)>,
+    pub b: Vec<(usize, f64)>,
+    /// The clutch's largest torque, at the wheels (over one side's wheels) \[N m\].
+    pub capacity: f64,
+}
+
 /// The compiled vehicle: everything the internal step needs that does not change.
 #[derive(Clone, Debug)]
 pub(crate) struct Model {
@@ -96,6 +108,8 @@ pub(crate) struct Model {
     pub step: f64,
     pub wheels: Vec<WheelModel>,
     pub groups: Vec<SpinGroup>,
+    /// Differential clutches between spin groups (empty unless a differential is `clutch`).
+    pub couplings: Vec<Coupling>,
     pub sprung_mass: f64,
     pub total_mass: f64,
     /// Chassis-only principal inertia and the composite (with unsprung masses) one.
@@ -168,6 +182,7 @@ impl Model {
         let h = spec.internal_step;
 
         let (groups, group_of) = spin_groups(spec);
+        let couplings = couplings(spec, &group_of);
         let driven_wheels = spec.axles.iter().filter(|a| a.driven).count() * 2;
 
         let mut wheels = Vec::with_capacity(spec.wheel_count());
@@ -324,6 +339,7 @@ impl Model {
             step: h,
             wheels,
             groups,
+            couplings,
             sprung_mass,
             total_mass,
             chassis_inertia: Vec3::new(
@@ -464,6 +480,37 @@ fn spin_groups(spec: &VehicleSpec) -> (Vec<SpinGroup>, Vec<usize>) {
         g.driven = driven_members > 0;
     }
     (groups, group_of)
+}
+
+/// The differential clutches: one between the two wheels of each driven axle with a clutch
+/// axle differential (its shafts turn with the wheels), and with a clutch central differential
+/// one between the two driven axles (its shafts turn `1 / final_drive` times faster than the
+/// wheels, so it passes `1 / final_drive` times its torque at the wheels). Validation allows a
+/// clutch central differential only with two driven axles whose differentials are not locked.
+fn couplings(spec: &VehicleSpec, group_of: &[usize]) -> Vec<Coupling> {
+    let p = &spec.powertrain;
+    let driven: Vec<usize> = (0..spec.axles.len())
+        .filter(|&k| spec.axles[k].driven && !spec.is_tracked())
+        .collect();
+    let mut out = Vec::new();
+    if let Differential::Clutch(torque) = p.axle_differential {
+        for &k in &driven {
+            out.push(Coupling {
+                a: vec![(group_of[2 * k], 1.0)],
+                b: vec![(group_of[2 * k + 1], 1.0)],
+                capacity: torque,
+            });
+        }
+    }
+    if let (Differential::Clutch(torque), [front, rear]) = (p.central_differential, &driven[..]) {
+        let side = |k: usize| vec![(group_of[2 * k], 1.0), (group_of[2 * k + 1], 1.0)];
+        out.push(Coupling {
+            a: side(*front),
+            b: side(*rear),
+            capacity: torque / p.final_drive,
+        });
+    }
+    out
 }
 
 /// Key identifying which spin group a wheel joins (None = its own group).

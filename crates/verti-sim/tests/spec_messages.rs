@@ -83,3 +83,46 @@ fn an_empty_file_says_so() {
     let m = error_for(|_| "# nothing here\n".to_string());
     assert!(m.starts_with("the file is empty"), "{m}");
 }
+
+/// A differential is `locked`, `open` or `{clutch: TORQUE}` (Chrono's locked differential: a
+/// clutch that slips beyond its locking torque); a bad one is named by its field, and a
+/// clutch reads back as written.
+#[test]
+fn differentials_read_as_locked_open_or_a_clutch() {
+    fn edit(axle: &'static str, central: &'static str) -> impl Fn(&str) -> String {
+        move |t: &str| {
+            t.replace(
+                "axle_differential: locked",
+                &format!("axle_differential: {axle}"),
+            )
+            .replace(
+                "central_differential: locked",
+                &format!("central_differential: {central}"),
+            )
+        }
+    }
+    let m = error_for(edit("welded", "locked"));
+    assert!(
+        m.contains("powertrain.axle_differential")
+            && m.contains("unknown differential `welded`: use locked, open or {clutch: TORQUE}"),
+        "{m}"
+    );
+    assert_eq!(
+        error_for(edit("{clutch: -5}", "locked")),
+        "field `powertrain.axle_differential.clutch`: -5 must be a finite number >= 0"
+    );
+    let m = error_for(edit("locked", "{clutch: 100}"));
+    assert!(
+        m.contains("powertrain.central_differential") && m.contains("locked axle differentials"),
+        "{m}"
+    );
+    // Chrono's HMMWV driveline reads, and writes back the same
+    let text = edit("{clutch: 100.0}", "{clutch: 100.0}")(vehicles::builtin_yaml("hmmwv").unwrap());
+    let spec = VehicleSpec::from_yaml_str(&text, "clutch.yaml").unwrap();
+    assert_eq!(
+        spec.powertrain.axle_differential,
+        verti_sim::spec::Differential::Clutch(100.0)
+    );
+    let again = VehicleSpec::from_yaml_str(&spec.to_yaml(), "again.yaml").unwrap();
+    assert_eq!(again.powertrain, spec.powertrain);
+}
