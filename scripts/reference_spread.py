@@ -3,6 +3,7 @@
 
     python3 scripts/reference_spread.py soil        # the soil reference set
     python3 scripts/reference_spread.py sections    # the friction-sections set
+    python3 scripts/reference_spread.py soil --vehicle my-hmmwv.yaml   # another vehicle file
 
 The reference files in ../shared/chrono-reference hold one Chrono run per task. Many tasks are
 chaotic: Chrono itself, re-run from a start a few centimetres away (or on another build), ends
@@ -32,13 +33,13 @@ REFERENCE = ROOT.parent / "shared" / "chrono-reference"
 SETS = {"soil": REFERENCE / "soil", "sections": REFERENCE / "sections"}
 
 
-def compare(reference):
+def compare(reference, vehicle):
     verti = ROOT / "target" / "release" / "verti"
     if not verti.is_file():
         sys.exit("reference_spread: no target/release/verti; run `cargo build --release -p verti-cli`")
     with tempfile.TemporaryDirectory() as out:
         done = subprocess.run(
-            [str(verti), "sim", "compare", str(reference), "--json", "--out", out],
+            [str(verti), "sim", "compare", str(reference), "--json", "--out", out, "--vehicle", vehicle],
             cwd=ROOT,
             check=True,
             capture_output=True,
@@ -54,15 +55,20 @@ def pairwise_agreement(draws):
 
 
 def main():
-    if len(sys.argv) != 2 or sys.argv[1] not in SETS:
-        sys.exit(f"usage: reference_spread.py {'|'.join(SETS)}")
-    name = sys.argv[1]
+    args = sys.argv[1:]
+    vehicle = "hmmwv"
+    if len(args) == 3 and args[1] == "--vehicle":
+        vehicle = args[2]
+        args = args[:1]
+    if len(args) != 1 or args[0] not in SETS:
+        sys.exit(f"usage: reference_spread.py {'|'.join(SETS)} [--vehicle FILE]")
+    name = args[0]
     members_file = ROOT / "benchmarks" / "chrono-members" / f"{name}.jsonl"
     members = collections.defaultdict(list)
     for line in members_file.read_text().splitlines():
         m = json.loads(line)
         members[(m["world_index"], m["pair"])].append(m["outcome"])
-    summary = compare(SETS[name])
+    summary = compare(SETS[name], str(pathlib.Path(vehicle).resolve()) if vehicle.endswith(".yaml") else vehicle)
     rows = []
     for t in summary["tasks"]:
         key = (t["world_index"], t["pair"])
