@@ -63,7 +63,10 @@ pub struct CompareArgs {
     ensemble: usize,
     /// Also write verti's trajectory of each task as `verti-world-NNN_pP.csv` in --out, in the
     /// reference's columns (t, x, y, z, roll, pitch, yaw, v, steer, throttle, brake, agl; agl is
-    /// the chassis position's height above the ground), to set beside the reference's file.
+    /// the chassis position's height above the ground), to set beside the reference's file,
+    /// and each wheel at the same times as `verti-world-NNN_pP-wheels.csv` (t, v, wheel, spin
+    /// omega, ground forces fx fy fz, gear, rpm: the columns of the Chrono harness's per-wheel
+    /// log).
     #[arg(long)]
     csv: bool,
     /// Compare every selected task, including reference trials that record an artifact of the
@@ -172,6 +175,9 @@ pub fn compare(a: CompareArgs) -> CmdResult {
                 let name = verti_compare::reference::trajectory_file_name(o.world_index, o.pair);
                 let text = verti_compare::reference::format_trajectory(&run.samples);
                 write(&a.out.join(format!("verti-{name}")), &text)?;
+                let wheels = verti_compare::run::format_wheels(&run.wheels);
+                let stem = name.trim_end_matches(".csv");
+                write(&a.out.join(format!("verti-{stem}-wheels.csv")), &wheels)?;
             }
             pb.inc(1);
             Ok(())

@@ -181,6 +181,19 @@ fn a_fall_through_is_left_out_and_csv_trajectories_are_written() {
         !out.join("verti-world-083_p3.csv").exists(),
         "left out, not run"
     );
+    // each wheel at the trajectory's sample times, in the harness's per-wheel columns
+    let wheels = std::fs::read_to_string(out.join("verti-world-083_p2-wheels.csv")).unwrap();
+    let mut lines = wheels.lines();
+    assert_eq!(lines.next(), Some("t,v,wheel,omega,fx,fy,fz,gear,rpm"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 4 * samples.len(), "four wheels per sample");
+    assert!(rows.iter().all(|r| r.len() == 9 && r[2] < 4.0));
+    assert!(
+        rows.iter().any(|r| r[6] > 1000.0),
+        "wheels carry the vehicle"
+    );
 
     let (summary, _) = run(&["--keep-artifacts"]);
     assert_eq!(summary["groups"][0]["tasks"], 2);

@@ -16,9 +16,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 use verti_bench::episode::{EpisodeLog, StepRecord};
-use verti_bench::{
-    EpisodeConfig, Feature, MobilitySystem, Rules, StartMode, TrialResult, run_episode,
-};
+use verti_bench::{EpisodeConfig, Feature, MobilitySystem, Rules, StartMode, TrialResult};
 use verti_sim::VehicleSpec;
 use verti_systems::pid::{Pid, PidParams};
 use verti_world::import_vb::{ImportOptions, import_vb, scan_vb_dir};
@@ -294,11 +292,46 @@ pub fn load_worlds(
     Ok(worlds.into_iter().collect())
 }
 
-/// One task driven by verti: the trial's record and its 10 Hz trajectory.
+/// One task driven by verti: the trial's record, its 10 Hz trajectory and, at the same times,
+/// each wheel's state.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VertiRun {
     pub result: TrialResult,
     pub samples: Vec<Sample>,
+    pub wheels: Vec<WheelSample>,
+}
+
+/// One wheel at one sample time, in the columns of the Chrono harness's per-wheel log
+/// (`vb_drive_wheels`, `VB_WHEELS`), so that the two can be set side by side.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WheelSample {
+    pub t: f64,
+    /// The vehicle's forward speed, m/s.
+    pub v: f64,
+    /// Wheel number: axle by axle, left then right.
+    pub wheel: usize,
+    /// Spin rate, rad/s.
+    pub omega: f64,
+    /// Ground forces on the wheel, N: along and across its contact frame, and normal.
+    pub fx: f64,
+    pub fy: f64,
+    pub fz: f64,
+    /// Gear (1-based, as Chrono numbers them) and engine speed, rpm.
+    pub gear: usize,
+    pub rpm: f64,
+}
+
+/// The per-wheel samples as CSV: `t,v,wheel,omega,fx,fy,fz,gear,rpm`, one line per wheel and
+/// sample time.
+pub fn format_wheels(wheels: &[WheelSample]) -> String {
+    let mut out = String::from("t,v,wheel,omega,fx,fy,fz,gear,rpm\n");
+    for w in wheels {
+        out.push_str(&format!(
+            "{:.3},{:.4},{},{:.4},{:.1},{:.1},{:.1},{},{:.0}\n",
+            w.t, w.v, w.wheel, w.omega, w.fx, w.fy, w.fz, w.gear, w.rpm
+        ));
+    }
+    out
 }
 
 /// Drives task `pair` of `world` (already prepared) as `setup` says.
@@ -309,19 +342,52 @@ pub fn run_task(world: &Arc<World>, pair: u32, setup: &CompareSetup) -> VertiRun
         Driver::Reference => Box::new(ReferenceDriver::new(p.speed, p.lookahead, p.rate)),
     };
     let mut log = EpisodeLog::default();
-    let result = run_episode(
+    let mut wheels = Vec::new();
+    // each wheel at the first step at or after each multiple of the sample period, as
+    // `resample` takes the trajectory
+    let mut next = 1u32;
+    let mut watch = |trial: &verti_bench::Trial| {
+        let t = trial.time();
+        if t + 1e-9 < f64::from(next) * SAMPLE_PERIOD {
+            return;
+        }
+        while f64::from(next) * SAMPLE_PERIOD <= t + 1e-9 {
+            next += 1;
+        }
+        let st = trial.state();
+        let (rpm, _) = st.engine();
+        for (k, w) in st.wheels().iter().enumerate() {
+            wheels.push(WheelSample {
+                t,
+                v: st.forward_speed(),
+                wheel: k,
+                omega: w.spin_rate,
+                fx: w.long_force,
+                fy: w.lat_force,
+                fz: w.normal_force,
+                gear: st.gear() + 1,
+                rpm,
+            });
+        }
+    };
+    let result = verti_bench::episode::run_episode_watched(
         world,
         &setup.vehicle,
         pair,
         system.as_mut(),
         &setup.episode,
         Some(&mut log),
+        &mut watch,
     );
     let mut samples = resample(&log.steps, SAMPLE_PERIOD);
     for s in &mut samples {
         s.agl = s.z - world.terrain.height_at(s.x, s.y);
     }
-    VertiRun { result, samples }
+    VertiRun {
+        result,
+        samples,
+        wheels,
+    }
 }
 
 /// Runs `tasks` (world index, pair) on `jobs` threads; the results are in the order of
