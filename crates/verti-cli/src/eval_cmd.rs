@@ -380,6 +380,14 @@ pub struct ReplayArgs {
     worlds: Option<String>,
 }
 
+/// The world scale a run recorded (its `run.json`), for resolving `--worlds` as the run did.
+fn replay_scale(run: &std::path::Path) -> Result<f64, String> {
+    let path = run.join(verti_bench::run::RUN_FILE);
+    verti_bench::run::identity::RunRecord::read(&path)
+        .map(|r| r.run.scale)
+        .map_err(|e| e.to_string())
+}
+
 /// Re-runs one task of an evaluation (trials are deterministic) with a per-step log and draws
 /// its trajectory over the world, coloured by speed, with the failure point marked.
 pub fn replay(a: ReplayArgs) -> CmdResult {
@@ -387,7 +395,8 @@ pub fn replay(a: ReplayArgs) -> CmdResult {
     let by_name = |name: &str| load_vehicle(name).map_err(|e| e.to_string());
     let worlds = match &a.worlds {
         Some(spec) => Some(
-            verti_world::sets::resolve_set(spec, 1.0, &|| {})
+            // at the run's scale, as the run's own set would be resolved
+            verti_world::sets::resolve_set(spec, replay_scale(&a.result)?, &|| {})
                 .map_err(|e| format!("--worlds {spec}: {e}"))?
                 .worlds
                 .into_iter()
