@@ -119,13 +119,7 @@ pub fn compare(a: CompareArgs) -> CmdResult {
     let (refs, excluded) = if a.keep_artifacts {
         (refs, Vec::new())
     } else {
-        let diameter = 2.0
-            * setup
-                .vehicle
-                .axles
-                .iter()
-                .map(|x| x.wheel.radius)
-                .fold(0.0, f64::max);
+        let diameter = setup.vehicle.largest_wheel_diameter();
         verti_compare::artifact::split_artifacts(refs, diameter)
     };
     for x in &excluded {

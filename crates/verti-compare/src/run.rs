@@ -343,16 +343,12 @@ pub fn run_task(world: &Arc<World>, pair: u32, setup: &CompareSetup) -> VertiRun
     };
     let mut log = EpisodeLog::default();
     let mut wheels = Vec::new();
-    // each wheel at the first step at or after each multiple of the sample period, as
-    // `resample` takes the trajectory
-    let mut next = 1u32;
+    // each wheel at the same steps as `resample` takes the trajectory
+    let mut clock = SampleClock::new(SAMPLE_PERIOD);
     let mut watch = |trial: &verti_bench::Trial| {
         let t = trial.time();
-        if t + 1e-9 < f64::from(next) * SAMPLE_PERIOD {
+        if !clock.due(t) {
             return;
-        }
-        while f64::from(next) * SAMPLE_PERIOD <= t + 1e-9 {
-            next += 1;
         }
         let st = trial.state();
         let (rpm, _) = st.engine();
@@ -424,19 +420,40 @@ pub(crate) fn pool(jobs: usize) -> Result<rayon::ThreadPool> {
         .map_err(|e| CompareError::Argument(format!("cannot start {jobs} threads: {e}")))
 }
 
+/// Picks, from steps in time order, the first at or after each multiple of `period` (how the
+/// reference samples its runs).
+struct SampleClock {
+    period: f64,
+    next: u32,
+}
+
+impl SampleClock {
+    fn new(period: f64) -> SampleClock {
+        SampleClock { period, next: 1 }
+    }
+
+    /// Whether the step at time `t` is a sample (then the clock moves past it).
+    fn due(&mut self, t: f64) -> bool {
+        if t + 1e-9 < f64::from(self.next) * self.period {
+            return false;
+        }
+        while f64::from(self.next) * self.period <= t + 1e-9 {
+            self.next += 1;
+        }
+        true
+    }
+}
+
 /// Samples of a step log every `period` seconds (the first step at or after each multiple), as
 /// the reference writes them.
 pub fn resample(steps: &[StepRecord], period: f64) -> Vec<Sample> {
     let get = |s: &StepRecord, f: Feature| s.get(f).unwrap_or(f64::NAN);
     let mut out = Vec::new();
-    let mut k = 1u32;
+    let mut clock = SampleClock::new(period);
     for s in steps {
         let t = s.t();
-        if t + 1e-9 < f64::from(k) * period {
+        if !clock.due(t) {
             continue;
-        }
-        while f64::from(k) * period <= t + 1e-9 {
-            k += 1;
         }
         out.push(Sample {
             t,

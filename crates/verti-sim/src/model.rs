@@ -320,7 +320,7 @@ impl Model {
         let beams = wheels
             .iter()
             .any(|w| w.coupling.is_some_and(|c| c.beam.is_some()));
-        let soil_floor = 2.0 * wheels.iter().map(|w| w.radius).fold(0.0, f64::max);
+        let soil_floor = spec.largest_wheel_diameter();
         // each wheel's (x, y) in the reference frame
         let wheel_xy: Vec<(f64, f64)> = wheels.iter().map(|m| (m.attach.x + com.x, m.y)).collect();
         let track_runs = TrackRuns::compile(

@@ -437,6 +437,16 @@ impl VehicleSpec {
         self.track.is_some()
     }
 
+    /// Diameter of the largest wheel \[m\]: how far below a soil surface the chassis meets a
+    /// floor, and below which a reference chassis has fallen through the soil.
+    pub fn largest_wheel_diameter(&self) -> f64 {
+        2.0 * self
+            .axles
+            .iter()
+            .map(|a| a.wheel.radius)
+            .fold(0.0, f64::max)
+    }
+
     /// Total mass: sprung + unsprung (+ tracks, which are part of the sprung mass).
     pub fn total_mass(&self) -> f64 {
         self.chassis.mass
