@@ -327,8 +327,9 @@ pub(crate) fn solve_spins(
     group_reaction
 }
 
-/// Gauss–Seidel sweeps over the differential clutches; the answer changes by less than
-/// 1e-9 of a clutch's capacity between the last two on the test vehicles.
+/// Gauss–Seidel sweeps over the differential clutches: with the three clutches of a four-wheel
+/// driveline, strong enough to hold, the unit test's spins are within 1e-6 of the locked
+/// driveline's after these.
 const CLUTCH_SWEEPS: usize = 12;
 
 /// The differential clutches ([`Coupling`]) on the groups' implicit equations `factor·ω = rhs`
@@ -346,6 +347,7 @@ fn hold_couplings(
     held: &[bool; MAX_WHEELS],
 ) -> [f64; MAX_WHEELS] {
     let mut added = [0.0; MAX_WHEELS];
+    // one torque per clutch: at most one per axle and a central one, fewer than MAX_WHEELS
     let mut lambda = [0.0; MAX_WHEELS];
     let side_wheels = |side: &[(usize, f64)]| side.iter().map(|&(_, n)| n).sum::<f64>();
     for _ in 0..CLUTCH_SWEEPS {
