@@ -59,5 +59,8 @@ def test_a_run_on_worlds_in_memory_replays_with_the_same_worlds(tmp_path):
         verti.replay(run, 1, tmp_path / "a.html")
     result = verti.replay(run, 1, tmp_path / "a.html", worlds=worlds)
     assert result["outcome"] == rows[0]["outcome"] and result["time"] == rows[0]["time"]
+    # the same worlds by name, resolved at the run's scale
+    by_name = verti.replay(run, 1, tmp_path / "n.html", worlds="verti-3")
+    assert by_name["time"] == rows[0]["time"]
     with pytest.raises(ValueError, match="not those the run"):
         verti.replay(run, 1, tmp_path / "b.html", worlds=verti.load_worlds("verti-3-s1"))

@@ -37,18 +37,30 @@ impl ReplaySetup {
     }
 }
 
+/// Where a replay finds the run's worlds. Every choice is checked by content against the run's
+/// record. A run made on worlds held in memory (`verti.evaluate` on a list of `World`s)
+/// records only a label such as `100 worlds`, which no name resolves: it needs one of the
+/// other two.
+pub enum ReplayWorlds {
+    /// The set the run names, at its recorded scale.
+    Recorded,
+    /// Another set name or path (as `verti eval --worlds`), or one world as `SET:INDEX`, at the
+    /// run's recorded scale.
+    Named(String),
+    /// The worlds themselves.
+    Given(Vec<Arc<World>>),
+}
+
 /// Reads `dir/run.json` and the result of `task`, and rebuilds its world (from the run's set,
 /// checked by content), vehicle (the recorded spec, checked by digest) and system (from
 /// `registry` with the recorded parameters). `vehicle_by_name` loads a vehicle for runs
-/// recorded before specs were kept. `worlds`, when given, is the run's world set itself (also
-/// checked by content): a run made on worlds held in memory (`verti.evaluate` on a list of
-/// `World`s) records only a label such as `100 worlds`, which no name resolves.
+/// recorded before specs were kept. `worlds` says where the worlds come from.
 pub fn prepare(
     dir: &Path,
     task: u32,
     registry: &SystemRegistry,
     vehicle_by_name: &dyn Fn(&str) -> Result<VehicleSpec, String>,
-    worlds: Option<Vec<Arc<World>>>,
+    worlds: ReplayWorlds,
 ) -> Result<ReplaySetup, String> {
     let run_path = dir.join(RUN_FILE);
     let record = RunRecord::read(&run_path).map_err(|e| e.to_string())?;
@@ -80,20 +92,31 @@ pub fn prepare(
     }
     let id = TaskId::from_number(task).ok_or("task numbers start at 1")?;
     // the whole set, to check by content that it is still the set the run used
-    let given = worlds.is_some();
+    let given = !matches!(worlds, ReplayWorlds::Recorded);
+    let as_set = |worlds: Vec<World>| worlds.into_iter().map(Arc::new).collect::<Vec<_>>();
     let set: Vec<Arc<World>> = match worlds {
-        Some(set) => set,
-        None => verti_world::sets::resolve_set(&run.worlds, run.scale, &|| {})
-            .map_err(|e| {
-                format!(
-                    "the run's world set `{}`: {e}; a run made on worlds held in memory is replayed by passing the same worlds (verti.replay(..., worlds=...), verti replay --worlds SET)",
-                    run.worlds
-                )
-            })?
-            .worlds
-            .into_iter()
-            .map(Arc::new)
-            .collect(),
+        ReplayWorlds::Given(set) => set,
+        ReplayWorlds::Named(spec) => {
+            let one_world = spec
+                .rsplit_once(':')
+                .is_some_and(|(_, i)| i.parse::<u32>().is_ok());
+            let resolved = if one_world {
+                verti_world::sets::resolve_world(&spec, run.scale).map(|w| vec![w])
+            } else {
+                verti_world::sets::resolve_set(&spec, run.scale, &|| {}).map(|s| s.worlds)
+            };
+            as_set(resolved.map_err(|e| format!("the worlds `{spec}`: {e}"))?)
+        }
+        ReplayWorlds::Recorded => as_set(
+            verti_world::sets::resolve_set(&run.worlds, run.scale, &|| {})
+                .map_err(|e| {
+                    format!(
+                        "the run's world set `{}`: {e}; a run made on worlds held in memory is replayed by passing the same worlds (verti.replay(..., worlds=...), verti replay --worlds SET)",
+                        run.worlds
+                    )
+                })?
+                .worlds,
+        ),
     };
     if let Some(d) = &record.worlds_digest
         && *d != crate::run::identity::set_digest(&set)

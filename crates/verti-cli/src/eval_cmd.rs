@@ -373,19 +373,12 @@ pub struct ReplayArgs {
     /// Pixels per heightfield cell.
     #[arg(long, default_value_t = 4)]
     px_per_cell: u32,
-    /// The run's world set (as `verti eval --worlds`), checked by content against the run's
-    /// record; by default the set the run names. Needed for a run made on worlds held in memory
-    /// (`verti.evaluate` on a list of worlds), whose record names no set.
+    /// The run's world set (as `verti eval --worlds`, or one world as SET:INDEX), at the run's
+    /// scale and checked by content against the run's record; by default the set the run names.
+    /// Needed for a run made on worlds held in memory (`verti.evaluate` on a list of worlds),
+    /// whose record names no set.
     #[arg(long)]
     worlds: Option<String>,
-}
-
-/// The world scale a run recorded (its `run.json`), for resolving `--worlds` as the run did.
-fn replay_scale(run: &std::path::Path) -> Result<f64, String> {
-    let path = run.join(verti_bench::run::RUN_FILE);
-    verti_bench::run::identity::RunRecord::read(&path)
-        .map(|r| r.run.scale)
-        .map_err(|e| e.to_string())
 }
 
 /// Re-runs one task of an evaluation (trials are deterministic) with a per-step log and draws
@@ -393,18 +386,11 @@ fn replay_scale(run: &std::path::Path) -> Result<f64, String> {
 pub fn replay(a: ReplayArgs) -> CmdResult {
     let registry = crate::registries::systems();
     let by_name = |name: &str| load_vehicle(name).map_err(|e| e.to_string());
-    let worlds = match &a.worlds {
-        Some(spec) => Some(
-            // at the run's scale, as the run's own set would be resolved
-            verti_world::sets::resolve_set(spec, replay_scale(&a.result)?, &|| {})
-                .map_err(|e| format!("--worlds {spec}: {e}"))?
-                .worlds
-                .into_iter()
-                .map(std::sync::Arc::new)
-                .collect(),
-        ),
-        None => None,
-    };
+    use verti_bench::replay::ReplayWorlds;
+    let worlds = a
+        .worlds
+        .clone()
+        .map_or(ReplayWorlds::Recorded, ReplayWorlds::Named);
     let mut setup = verti_bench::replay::prepare(&a.result, a.task, &registry, &by_name, worlds)?;
     let (world, vehicle, pair) = (setup.world.clone(), setup.vehicle.clone(), setup.pair);
     let ext = a.out.extension().and_then(|e| e.to_str()).unwrap_or("");

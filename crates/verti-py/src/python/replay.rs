@@ -7,8 +7,8 @@ use super::*;
 /// HTML page (terrain, obstacles, vehicle body and wheels, path, trail, time series). Returns
 /// the replayed trial's result dict; warns if it ended otherwise than the recorded one.
 /// A `.json` output gets the recording itself (what `verti.rerun` converts to Rerun's format).
-/// `worlds` (a World, a list of Worlds or a set name) replaces the set the run names, checked
-/// by content: needed for a run made on worlds held in memory.
+/// `worlds` (a World, a list of Worlds or a set name, resolved at the run's scale) replaces the
+/// set the run names, checked by content: needed for a run made on worlds held in memory.
 #[pyfunction]
 #[pyo3(signature = (run, task, out, worlds = None))]
 pub(super) fn _replay(
@@ -23,9 +23,14 @@ pub(super) fn _replay(
     let as_json = out.extension().and_then(|e| e.to_str()) == Some("json");
     let registry = system_registry();
     let by_name = |name: &str| vehicle_spec(name).map_err(|e| e.to_string());
+    use verti_bench::replay::ReplayWorlds;
     let worlds = match worlds {
-        Some(w) if !w.is_none() => Some(worlds_arg(py, w, None)?.0),
-        _ => None,
+        None => ReplayWorlds::Recorded,
+        Some(w) if w.is_none() => ReplayWorlds::Recorded,
+        Some(w) => match w.cast::<PyString>() {
+            Ok(name) => ReplayWorlds::Named(name.extract()?),
+            Err(_) => ReplayWorlds::Given(worlds_arg(py, w, None)?.0),
+        },
     };
     let mut setup =
         verti_bench::replay::prepare(&run, task, &registry, &by_name, worlds).map_err(value_err)?;
