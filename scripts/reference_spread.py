@@ -68,7 +68,10 @@ def main():
     for line in members_file.read_text().splitlines():
         m = json.loads(line)
         members[(m["world_index"], m["pair"])].append(m["outcome"])
-    summary = compare(SETS[name], str(pathlib.Path(vehicle).resolve()) if vehicle.endswith(".yaml") else vehicle)
+    # a vehicle file given from elsewhere still names the same file from the repository root
+    if pathlib.Path(vehicle).exists():
+        vehicle = str(pathlib.Path(vehicle).resolve())
+    summary = compare(SETS[name], vehicle)
     rows = []
     for t in summary["tasks"]:
         key = (t["world_index"], t["pair"])

@@ -291,11 +291,44 @@ const REQUIRED_COLUMNS: [&str; 7] = ["t", "x", "y", "z", "roll", "pitch", "yaw"]
 /// Columns read when present.
 const OPTIONAL_COLUMNS: [&str; 5] = ["v", "steer", "throttle", "brake", "agl"];
 
-/// A sample's values in the order of [`REQUIRED_COLUMNS`] then [`OPTIONAL_COLUMNS`].
+/// A sample's values in the order of [`REQUIRED_COLUMNS`] then [`OPTIONAL_COLUMNS`] (the
+/// writer's order; [`sample_from_values`] is the reader's).
 fn sample_values(s: &Sample) -> [f64; 12] {
     [
         s.t, s.x, s.y, s.z, s.roll, s.pitch, s.yaw, s.v, s.steer, s.throttle, s.brake, s.agl,
     ]
+}
+
+/// The sample whose values, in [`sample_values`]' order, are `v`.
+fn sample_from_values(v: [f64; 12]) -> Sample {
+    let [
+        t,
+        x,
+        y,
+        z,
+        roll,
+        pitch,
+        yaw,
+        speed,
+        steer,
+        throttle,
+        brake,
+        agl,
+    ] = v;
+    Sample {
+        t,
+        x,
+        y,
+        z,
+        roll,
+        pitch,
+        yaw,
+        v: speed,
+        steer,
+        throttle,
+        brake,
+        agl,
+    }
 }
 
 /// `samples` as a trajectory CSV that [`parse_trajectory`] reads back: the required columns and
@@ -382,20 +415,10 @@ pub fn parse_trajectory(text: &str, path: &Path) -> Result<Vec<Sample>> {
             .iter()
             .map(|k| k.map_or(Ok(f64::NAN), value))
             .collect::<Result<_>>()?;
-        let s = Sample {
-            t: r[0],
-            x: r[1],
-            y: r[2],
-            z: r[3],
-            roll: r[4],
-            pitch: r[5],
-            yaw: r[6],
-            v: o[0],
-            steer: o[1],
-            throttle: o[2],
-            brake: o[3],
-            agl: o[4],
-        };
+        let mut values = [0.0; 12];
+        values[..REQUIRED_COLUMNS.len()].copy_from_slice(&r);
+        values[REQUIRED_COLUMNS.len()..].copy_from_slice(&o);
+        let s = sample_from_values(values);
         if let Some(prev) = out.last()
             && s.t <= prev.t
         {

@@ -349,34 +349,30 @@ fn hold_couplings(
     let mut added = [0.0; MAX_WHEELS];
     // one torque per clutch: at most one per axle and a central one, fewer than MAX_WHEELS
     let mut lambda = [0.0; MAX_WHEELS];
-    let side_wheels = |side: &[(usize, f64)]| side.iter().map(|&(_, n)| n).sum::<f64>();
     for _ in 0..CLUTCH_SWEEPS {
         for (k, c) in couplings.iter().enumerate() {
-            if c.a.iter().chain(&c.b).any(|&(g, _)| held[g]) {
+            if c.a.iter().chain(&c.b).any(|&g| held[g]) {
                 continue;
             }
-            let (na, nb) = (side_wheels(&c.a), side_wheels(&c.b));
-            // mean spin of a side as it stands, and its change per unit of Λ
-            let mean = |side: &[(usize, f64)], n: f64| {
-                side.iter()
-                    .map(|&(g, m)| m * rhs[g] / factor[g])
-                    .sum::<f64>()
-                    / n
+            // mean spin of a side as it stands, and its change per unit of Λ (one wheel per
+            // group, Λ/n to each of a side's n wheels)
+            let mean = |side: &[usize]| {
+                side.iter().map(|&g| rhs[g] / factor[g]).sum::<f64>() / side.len() as f64
             };
-            let gain = |side: &[(usize, f64)], n: f64| {
-                side.iter().map(|&(g, m)| m * m / factor[g]).sum::<f64>() / (n * n)
+            let gain = |side: &[usize]| {
+                let n = side.len() as f64;
+                side.iter().map(|&g| 1.0 / factor[g]).sum::<f64>() / (n * n)
             };
-            let step = (mean(&c.b, nb) - mean(&c.a, na)) / (gain(&c.a, na) + gain(&c.b, nb));
+            let step = (mean(&c.b) - mean(&c.a)) / (gain(&c.a) + gain(&c.b));
             let total = (lambda[k] + step).clamp(-c.capacity, c.capacity);
             let delta = total - lambda[k];
             lambda[k] = total;
-            for &(g, m) in &c.a {
-                rhs[g] += delta * m / na;
-                added[g] += delta * m / na;
-            }
-            for &(g, m) in &c.b {
-                rhs[g] -= delta * m / nb;
-                added[g] -= delta * m / nb;
+            for (side, sign) in [(&c.a, 1.0), (&c.b, -1.0)] {
+                let share = sign * delta / side.len() as f64;
+                for &g in side {
+                    rhs[g] += share;
+                    added[g] += share;
+                }
             }
         }
     }
@@ -570,8 +566,8 @@ mod tests {
         let f = arrays(&[8.3 / 0.005, 8.3 / 0.005]);
         let held = [false; MAX_WHEELS];
         let pair = |capacity| Coupling {
-            a: vec![(0, 1.0)],
-            b: vec![(1, 1.0)],
+            a: vec![0],
+            b: vec![1],
             capacity,
         };
         let (r0, r1) = (8.3 * 10.0 / 0.005 + 900.0, 8.3 * 10.0 / 0.005 + 300.0);
@@ -610,18 +606,18 @@ mod tests {
         let held = [false; MAX_WHEELS];
         let clutches = [
             Coupling {
-                a: vec![(0, 1.0)],
-                b: vec![(1, 1.0)],
+                a: vec![0],
+                b: vec![1],
                 capacity: 1e5,
             },
             Coupling {
-                a: vec![(2, 1.0)],
-                b: vec![(3, 1.0)],
+                a: vec![2],
+                b: vec![3],
                 capacity: 1e5,
             },
             Coupling {
-                a: vec![(0, 1.0), (1, 1.0)],
-                b: vec![(2, 1.0), (3, 1.0)],
+                a: vec![0, 1],
+                b: vec![2, 3],
                 capacity: 1e5,
             },
         ];

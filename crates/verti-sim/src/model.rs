@@ -94,9 +94,10 @@ pub(crate) struct SpinGroup {
 /// Its torque goes in equal parts to the wheels of one set and out of the other's.
 #[derive(Clone, Debug)]
 pub(crate) struct Coupling {
-    /// Each side's spin groups, with how many of the side's wheels each holds.
-    pub a: Vec<(usize, f64)>,
-    pub b: Vec<(usize, f64)>,
+    /// Each side's spin groups. A clutch differential leaves every wheel its own group (a
+    /// central clutch is refused with locked axle differentials), so a group is one wheel.
+    pub a: Vec<usize>,
+    pub b: Vec<usize>,
     /// The clutch's largest torque, at the wheels (over one side's wheels) \[N m\].
     pub capacity: f64,
 }
@@ -489,21 +490,24 @@ fn spin_groups(spec: &VehicleSpec) -> (Vec<SpinGroup>, Vec<usize>) {
 /// clutch central differential only with two driven axles whose differentials are not locked.
 fn couplings(spec: &VehicleSpec, group_of: &[usize]) -> Vec<Coupling> {
     let p = &spec.powertrain;
-    let driven: Vec<usize> = (0..spec.axles.len())
-        .filter(|&k| spec.axles[k].driven && !spec.is_tracked())
-        .collect();
     let mut out = Vec::new();
+    if spec.is_tracked() {
+        return out; // a track's side is its spin group; the differentials play no part
+    }
+    let driven: Vec<usize> = (0..spec.axles.len())
+        .filter(|&k| spec.axles[k].driven)
+        .collect();
     if let Differential::Clutch(torque) = p.axle_differential {
         for &k in &driven {
             out.push(Coupling {
-                a: vec![(group_of[2 * k], 1.0)],
-                b: vec![(group_of[2 * k + 1], 1.0)],
+                a: vec![group_of[2 * k]],
+                b: vec![group_of[2 * k + 1]],
                 capacity: torque,
             });
         }
     }
     if let (Differential::Clutch(torque), [front, rear]) = (p.central_differential, &driven[..]) {
-        let side = |k: usize| vec![(group_of[2 * k], 1.0), (group_of[2 * k + 1], 1.0)];
+        let side = |k: usize| vec![group_of[2 * k], group_of[2 * k + 1]];
         out.push(Coupling {
             a: side(*front),
             b: side(*rear),
