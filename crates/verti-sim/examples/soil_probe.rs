@@ -3,7 +3,9 @@
 //! 0.05 per 5 ms step) on a test world, printing a 10 Hz trace `t,x,y,z,roll,pitch,yaw,v,throttle`
 //! and per-wheel sinkage. Worlds: `ramp SOIL` (flat to x = −35, then a slope growing 0.8/90 per
 //! metre; heights quantised to 16 bits of 45 m as in the PNG the Chrono run reads), `side SOIL DEG`
-//! (a constant side slope, ground falling towards −y).
+//! (a constant side slope, ground falling towards −y), `edge SOIL` (flat: soil for x < 0, rigid
+//! ground of friction 0.8 for x > 0, the step out of the soil onto a rigid patch; the Chrono side
+//! is an SCM patch over x < 0 beside a rigid box patch over x > 0).
 //! `cargo run -p verti-sim --release --example soil_probe -- ramp mud > trace.csv`
 use std::sync::Arc;
 use verti_sim::{Controls, Sim, StartPose, testing, vehicles};
@@ -34,6 +36,10 @@ fn main() {
             * verti_world::surface::PATCHES_PER_SIDE
     ];
     let world = match kind {
+        "edge" => {
+            let soil = soil(soil_name).unwrap_or(SoilParams::SOFT);
+            testing::half_soil_world(1.0, soil, 0.8)
+        }
         "side" => {
             let t = deg.to_radians().tan();
             testing::world_from_fn("side", 1.0, move |_, y| t * (y + 64.0), patches, Vec::new())
@@ -58,15 +64,28 @@ fn main() {
         }
     };
     let world = Arc::new(world);
-    let spec = vehicles::builtin("hmmwv").unwrap();
+    // VERTI_PROBE_VEHICLE=NAME: another built-in vehicle (the per-wheel columns are its first four)
+    let vehicle = std::env::var("VERTI_PROBE_VEHICLE").unwrap_or_else(|_| "hmmwv".into());
+    let spec = vehicles::builtin(&vehicle).unwrap();
     let sim = Sim::new(&world, &spec).unwrap();
     // VERTI_PROBE_DROP=1: the reference's start, 1 m above the ground (throttle from t = 0)
     let start = StartPose::new(-55.0, 0.0, 0.0);
+    // (the start faces +x; a heading is reached within the first metres)
     let mut st = if std::env::var_os("VERTI_PROBE_DROP").is_some() {
         sim.state_dropped(start, 1.0).unwrap()
     } else {
         sim.state_at(start).unwrap()
     };
+    let heading = std::env::var("VERTI_PROBE_HEADING")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+        .unwrap_or(0.0)
+        .to_radians();
+    // VERTI_PROBE_SPEED=M/S: the driver's target speed (default the reference's 3 m/s)
+    let speed: f64 = std::env::var("VERTI_PROBE_SPEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3.0);
     let dt = 0.005;
     let mut steer = 0.0f64;
     println!(
@@ -76,12 +95,16 @@ fn main() {
     for k in 0..steps {
         let p = st.com_position();
         let (_, _, yaw) = st.euler();
-        let target = (p.x + 10.0, 0.0);
+        // VERTI_PROBE_HEADING=DEG: follow the line through the start at that angle to +x
+        let target = (
+            p.x + 10.0 * heading.cos(),
+            (p.x + 10.0 * heading.cos() + 55.0) * heading.tan(),
+        );
         let want = (target.1 - p.y).atan2(target.0 - p.x);
         let err = (want - yaw + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
             - std::f64::consts::PI;
         steer = (steer + (err - steer).clamp(-0.05, 0.05)).clamp(-1.0, 1.0);
-        let u = (3.0 - st.forward_speed()).clamp(-1.0, 1.0);
+        let u = (speed - st.forward_speed()).clamp(-1.0, 1.0);
         let c = Controls::new(u.max(0.0), (-u).max(0.0), steer);
         if let Err(e) = sim.step(&mut st, c, dt) {
             eprintln!("error {e}");

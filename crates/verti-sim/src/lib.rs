@@ -46,6 +46,7 @@ mod math;
 mod model;
 mod sim;
 mod soil;
+mod soil_edges;
 pub mod spec;
 mod start;
 mod state;

@@ -63,6 +63,10 @@ pub(crate) struct WheelModel {
     /// (signed: times +1 on the left, −1 on the right; 0 for none): the wheel's lateral ground
     /// force jacks its travel by this share.
     pub jacking: f64,
+    /// A road wheel inside a track whose belt is modelled (`track_runs`): where a rigid patch
+    /// borders soil, the belt spanning the road wheels meets the patch's edge, not the wheel
+    /// (`soil_edges`).
+    pub belted: bool,
 }
 
 /// The coupling of a wheel to the other end of its axle (a beam, an anti-roll bar): the
@@ -279,6 +283,7 @@ impl Model {
                     coupling,
                     link_share,
                     jacking,
+                    belted: false,
                 });
             }
         }
@@ -332,6 +337,11 @@ impl Model {
             body_stiffness,
             body_damping,
         );
+        if let Some(runs) = &track_runs {
+            for &w in runs.sides.iter().flat_map(|side| &side.wheels) {
+                wheels[w].belted = true;
+            }
+        }
         let wheelbase = wheels
             .iter()
             .find(|w| w.steered)

@@ -5,8 +5,10 @@
 
 use crate::error::SimError;
 use crate::soil::{SOIL_DELTA_FULL_SCALE, SoilLayout};
+use crate::soil_edges::{Disc, SoilEdges};
 use std::ops::RangeInclusive;
 use std::sync::Arc;
+use verti_core::Vec3;
 use verti_world::World;
 
 /// The world a vehicle drives on, with the lookup structures the contact stages use.
@@ -23,6 +25,8 @@ pub(crate) struct Terrain {
     pub soil: Option<SoilLayout>,
     /// Whether any patch is rigid (the belly contacts act on rigid ground only).
     pub rigid_patches: bool,
+    /// The sides of rigid patches that border soil, when any do.
+    pub soil_edges: Option<SoilEdges>,
 }
 
 impl Terrain {
@@ -53,7 +57,60 @@ impl Terrain {
                 .patches()
                 .iter()
                 .any(|p| !p.surface.is_deformable()),
+            soil_edges: SoilEdges::new(world),
         })
+    }
+
+    /// The shortest way out of rigid ground for a point `p` in patch `patch` that is `depth`
+    /// under its surface along `normal`: that, or sideways through a side the patch shares
+    /// with soil (`soil_edges`).
+    #[inline]
+    pub fn rigid_exit(&self, p: Vec3, patch: usize, depth: f64, normal: Vec3) -> (f64, Vec3) {
+        match &self.soil_edges {
+            Some(edges) => edges.exit(p, patch, depth, normal),
+            None => (depth, normal),
+        }
+    }
+
+    /// The same for a point `p` of a wheel's tread with axle `axle`: `None` where the wheel
+    /// meets a side's edge as a curb instead ([`Terrain::wheel_corner`]).
+    #[inline]
+    pub fn wheel_rigid_point(
+        &self,
+        p: Vec3,
+        patch: usize,
+        depth: f64,
+        normal: Vec3,
+        axle: Vec3,
+    ) -> Option<(f64, Vec3)> {
+        match &self.soil_edges {
+            Some(edges) => edges.wheel_point(p, patch, depth, normal, axle),
+            None => Some((depth, normal)),
+        }
+    }
+
+    /// `SoilEdges::exit_along`, for worlds with soil edges.
+    #[inline]
+    pub fn rigid_exit_along(
+        &self,
+        p: Vec3,
+        patch: usize,
+        rise: f64,
+        slope: (f64, f64),
+        u: Vec3,
+    ) -> Option<f64> {
+        self.soil_edges
+            .as_ref()?
+            .exit_along(p, patch, rise, slope, u)
+    }
+
+    /// A wheel over soil against the top edges of the rigid patches beside it
+    /// (`SoilEdges::wheel_corner`): depth, normal and contact point relative to the hub.
+    #[inline]
+    pub fn wheel_corner(&self, wheel: Disc) -> Option<(f64, Vec3, Vec3)> {
+        let edges = self.soil_edges.as_ref()?;
+        let hub = wheel.0;
+        edges.wheel_corner(&self.ground, self.ground.patch_index(hub.x, hub.y), wheel)
     }
 }
 

@@ -129,6 +129,21 @@ pub fn soil_world(scale: f64, soil: SoilParams, slope_x: f64) -> World {
     )
 }
 
+/// Flat ground at z = 0: soil west of x = 0 (patch columns 0-7), rigid ground of `friction`
+/// east of it: a straight edge between rigid ground and soil along the y axis.
+pub fn half_soil_world(scale: f64, soil: SoilParams, friction: f64) -> World {
+    let patches = (0..PATCHES_PER_SIDE * PATCHES_PER_SIDE)
+        .map(|k| {
+            if k % PATCHES_PER_SIDE < PATCHES_PER_SIDE / 2 {
+                soil_patch(soil)
+            } else {
+                rigid_patch(friction)
+            }
+        })
+        .collect();
+    world_from_fn("half-soil", scale, |_, _| 0.0, patches, Vec::new())
+}
+
 /// Rolling bumps: sum of two sines of the given amplitude and wavelength (at full scale).
 pub fn bumpy_world(scale: f64, amplitude: f64, wavelength: f64, friction: f64) -> World {
     let k = std::f64::consts::TAU / (wavelength * scale);

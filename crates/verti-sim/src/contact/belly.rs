@@ -156,7 +156,8 @@ pub(crate) fn belly_contacts(
                 continue;
             }
             // the vertex's own patch (fixed, so a contact cannot flicker as the box moves)
-            let surface = &patches[ground.patch_index(v.x, v.y)].surface;
+            let patch = ground.patch_index(v.x, v.y);
+            let surface = &patches[patch].surface;
             if surface.is_deformable() {
                 continue;
             }
@@ -166,10 +167,11 @@ pub(crate) fn belly_contacts(
             if depth <= ROUNDING * cell {
                 continue;
             }
+            let (depth, normal) = terrain.rigid_exit(at, patch, depth * up.z, up);
             let contact = Push {
                 point: at,
-                normal: up,
-                depth: depth * up.z,
+                normal,
+                depth,
                 mu: surface_mu(surface).min(mu_body),
                 share: share * cell_stiffness,
             };

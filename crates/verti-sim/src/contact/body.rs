@@ -82,7 +82,8 @@ pub(crate) fn body_contacts(
             if h <= p.z {
                 continue;
             }
-            let surface = &patches[terrain.ground.patch_index(p.x, p.y)].surface;
+            let patch = terrain.ground.patch_index(p.x, p.y);
+            let surface = &patches[patch].surface;
             // soil holds the chassis only at a floor far below its surface
             let h = body_ground(h, surface, model);
             if h <= p.z {
@@ -90,8 +91,13 @@ pub(crate) fn body_contacts(
             }
             let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
             let n = Vec3::new(-gx * nz, -gy * nz, nz);
+            let (depth, n) = if surface.is_deformable() {
+                ((h - p.z) * nz, n)
+            } else {
+                terrain.rigid_exit(*p, patch, (h - p.z) * nz, n)
+            };
             let mu = surface_mu(surface).min(mu_body);
-            if apply(*p, n, (h - p.z) * nz, mu, 1.0, 1.0) {
+            if apply(*p, n, depth, mu, 1.0, 1.0) {
                 contacts.chassis_terrain_points += 1;
             }
         }

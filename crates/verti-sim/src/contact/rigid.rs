@@ -188,20 +188,25 @@ pub(crate) fn rigid_wheel_contact(
     {
         let p = hub + d_up * r;
         let (h, gx, gy) = ground.sample(p.x, p.y);
-        let surface = &patches[ground.patch_index(p.x, p.y)].surface;
+        let patch = ground.patch_index(p.x, p.y);
+        let surface = &patches[patch].surface;
         // Soil the grid resolves is the soil stage's; off the map, or where the grid cannot
         // resolve this wheel, soil is rigid ground of friction tan φ.
         if surface.is_deformable() && !soil_rigid && hf.contains(p.x, p.y) {
             soil_here = true;
         } else {
             let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
-            let n = Vec3::new(-gx * nz, -gy * nz, nz);
+            let top = Vec3::new(-gx * nz, -gy * nz, nz);
+            // near a side bordering soil the way out may be sideways, or the edge a curb (below)
+            let (depth, n) = terrain
+                .wheel_rigid_point(p, patch, (h - p.z) * nz, top, axle)
+                .unwrap_or((f64::NEG_INFINITY, top));
             let np = n - axle * n.dot(axle);
             let npn = np.norm();
             if npn > 1e-6 {
                 d0 = -np / npn;
             }
-            let deepest = (h - p.z) * nz + r * (d_up.dot(n) + npn);
+            let deepest = depth + r * (d_up.dot(n) + npn);
             // The two edges of the tread against the ground's plane (the heightfield is
             // planar over a triangle, and the tread is a quarter of a cell wide): each
             // carries half the stiffness, so a line contact sums to k·δ and a wheel tilted
@@ -224,22 +229,27 @@ pub(crate) fn rigid_wheel_contact(
             continue;
         }
         let (h, gx, gy) = ground.sample(p.x, p.y);
-        let surface = &patches[ground.patch_index(p.x, p.y)].surface;
+        let patch = ground.patch_index(p.x, p.y);
+        let surface = &patches[patch].surface;
         if surface.is_deformable() && !soil_rigid && hf.contains(p.x, p.y) {
             soil_here = true;
             continue;
         }
         let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
-        let n = Vec3::new(-gx * nz, -gy * nz, nz);
+        let top = Vec3::new(-gx * nz, -gy * nz, nz);
+        let Some((depth, n)) = terrain.wheel_rigid_point(p, patch, (h - p.z) * nz, top, axle)
+        else {
+            continue;
+        };
         let tilt = hw * axle.dot(n);
-        sum.add_edges(
-            dir * r,
-            -axle * hw,
-            (h - p.z) * nz,
-            tilt,
-            n,
-            surface_mu(surface),
-        );
+        sum.add_edges(dir * r, -axle * hw, depth, tilt, n, surface_mu(surface));
+    }
+    // a wheel in soil against the top edge of a rigid patch beside it: a curb
+    if let Some((depth, n, arm)) = terrain.wheel_corner((hub, axle, r)).filter(|_| !m.belted) {
+        // the rigid patch: just beyond the contact point, away from the hub
+        let at = hub + arm - n * 0.01;
+        let mu = surface_mu(&patches[ground.patch_index(at.x, at.y)].surface);
+        sum.add_edges(arm, -axle * hw, depth, hw * axle.dot(n), n, mu);
     }
     if !soil_here && terrain.soil.is_some() {
         // the wheel may be sunk in soil with its samples above the undeformed level

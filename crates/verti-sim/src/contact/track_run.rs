@@ -177,13 +177,33 @@ pub(crate) fn track_run_contacts(
                     let (h, gx, gy) = terrain.ground.sample(p.x, p.y);
                     // the patch only where the surface reaches the point (a soil floor is lower)
                     if h > p.z {
-                        let surface = &patches[terrain.ground.patch_index(p.x, p.y)].surface;
+                        let patch = terrain.ground.patch_index(p.x, p.y);
+                        let surface = &patches[patch].surface;
                         let h = body_ground(h, surface, model);
                         if h > p.z {
                             let mu = surface_mu(surface).min(runs.mu);
                             let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
                             let n = Vec3::new(-gx * nz, -gy * nz, nz);
-                            touch(arm, belt, n, (h - p.z) * nz, mu);
+                            let top = (h - p.z) * nz;
+                            let (depth, face) = if surface.is_deformable() {
+                                (top, n)
+                            } else {
+                                terrain.rigid_exit(p, patch, top, n)
+                            };
+                            if depth < top {
+                                // the edge of a rigid patch beside soil pokes into the track:
+                                // along the track's normal, as a rock's edge does
+                                let along =
+                                    terrain.rigid_exit_along(p, patch, h - p.z, (gx, gy), inward);
+                                match along {
+                                    Some(t) if t <= depth / MIN_EXIT_RATE => {
+                                        touch(arm, belt, inward, t, mu)
+                                    }
+                                    _ => touch(arm, belt, face, depth, mu),
+                                }
+                            } else {
+                                touch(arm, belt, n, top, mu);
+                            }
                         }
                     }
                 }

@@ -79,7 +79,8 @@ pub(crate) fn wheel_contact(
             if h <= p.z {
                 continue;
             }
-            let surface = &patches[ground.patch_index(p.x, p.y)].surface;
+            let patch = ground.patch_index(p.x, p.y);
+            let surface = &patches[patch].surface;
             // Soil on the map that the grid resolves is the soil stage's (below). Beyond the
             // map edge there are no soil nodes, and a grid that cannot resolve this wheel (see
             // `soil_as_rigid`) does not act: there the soil is rigid ground of friction tan φ.
@@ -89,12 +90,28 @@ pub(crate) fn wheel_contact(
             }
             let mu = surface_mu(surface);
             let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
-            let depth = (h - p.z) * nz;
+            let top = Vec3::new(-gx * nz, -gy * nz, nz);
+            // near a side bordering soil the way out may be sideways, or the edge a curb (below)
+            let Some((depth, normal)) =
+                terrain.wheel_rigid_point(*p, patch, (h - p.z) * nz, top, axle)
+            else {
+                continue;
+            };
             if depth > best_depth {
                 best_depth = depth;
-                best_normal = Vec3::new(-gx * nz, -gy * nz, nz);
+                best_normal = normal;
                 best_mu = mu;
             }
+        }
+        // a wheel in soil against the top edge of a rigid patch beside it: a curb
+        if let Some((depth, normal, _)) = terrain.wheel_corner((hub, axle, r)).filter(|_| !m.belted)
+            && depth > best_depth
+        {
+            // the rigid patch: just beyond the contact point, away from the hub
+            let at = hub - normal * (r + 0.01);
+            best_depth = depth;
+            best_normal = normal;
+            best_mu = surface_mu(&patches[ground.patch_index(at.x, at.y)].surface);
         }
         if !soil_here && terrain.soil.is_some() {
             // the wheel may be sunk in soil with its rim samples above the undeformed level

@@ -1,0 +1,100 @@
+"""Re-runs, in committed evaluations, only the tasks on one terrain type, after an engine change
+that provably touches no other (e.g. the rigid/soil edges, which exist only on mixed worlds).
+
+    python3 scripts/rerun_terrain.py --bin target/release/verti --terrain mixed [RUN_DIR ...]
+
+For each run folder (default: every benchmarks/**/run.json whose results hold such tasks) it
+removes those tasks' results, lets `verti eval --resume --out DIR` recompute them from the
+run's own record (system, parameters, vehicle, worlds, tasks), and sorts the results by task.
+The other results stay as they are: run the full evaluation of one cheap system with the new
+binary and compare digests (`scripts/results_digest.py`) to check that they would come out the
+same. Resumable: a folder already done is recomputed only for tasks still missing. Then
+`bash scripts/benchmarks.sh pack`.
+"""
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+
+def lines(path):
+    """The result lines of `path`, as written (kept byte for byte), with their parsed rows."""
+    return [(line, json.loads(line)) for line in path.open() if line.strip()]
+
+
+def value(v):
+    """A recorded parameter as `--param` takes it."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    return str(v)
+
+
+def eval_args(run):
+    """The `verti eval` arguments that reproduce the run recorded in `run`/run.json (the resume
+    check refuses any difference, so a wrong guess cannot mix runs)."""
+    rec = json.loads((run / "run.json").read_text())
+    out = ["--system", rec["system"], "--vehicle", rec["vehicle"], "--worlds", rec["worlds"]]
+    out += ["--scale", repr(rec["scale"]), "--compat", rec["rules"], "--seed", str(rec["seed"])]
+    out += ["--max-time", repr(rec["max_time"]), "--start", rec["start"]]
+    if rec.get("tasks") not in (None, "all"):
+        out += ["--tasks", rec["tasks"]]
+    for k, v in rec["params"].items():
+        out += ["--param", f"{k}={value(v)}"]
+    perception = rec.get("perception")
+    if perception:
+        name = perception["name"] if isinstance(perception, dict) else perception
+        out += ["--perception", name if name in ("low", "medium", "high") else f"docs/perception/{name}.yaml"]
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--bin", required=True, help="the verti binary to evaluate with")
+    ap.add_argument("--terrain", required=True, choices=["rigid", "deformable", "mixed"])
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--skip", action="append", default=[], help="skip run folders containing this")
+    ap.add_argument("runs", nargs="*", help="run folders (default: all under benchmarks/)")
+    args = ap.parse_args()
+    root = Path(__file__).resolve().parent.parent
+    runs = [Path(r) for r in args.runs] or sorted(
+        p.parent for p in (root / "benchmarks").rglob("run.json")
+    )
+    for run in runs:
+        if any(s in str(run) for s in args.skip):
+            print(f"skip {run}", flush=True)
+            continue
+        results = run / "results.jsonl"
+        if not results.exists():
+            print(f"{run}: no results.jsonl (bash scripts/benchmarks.sh unpack)", file=sys.stderr)
+            sys.exit(2)
+        rs = lines(results)
+        keep = [(line, r) for line, r in rs if r.get("terrain_type") != args.terrain]
+        redo = len(rs) - len(keep)
+        if redo == 0:
+            continue
+        start = time.time()
+        with results.open("w") as f:
+            f.writelines(line for line, _ in keep)
+        done = subprocess.run(
+            [args.bin, "eval", *eval_args(run), "--resume", "--out", str(run), "--jobs", str(args.jobs)],
+            capture_output=True,
+            text=True,
+            cwd=root,
+        )
+        if done.returncode != 0:
+            print(f"{run}: verti eval failed:\n{done.stderr}", file=sys.stderr)
+            sys.exit(1)
+        after = sorted(lines(results), key=lambda lr: lr[1]["task"])
+        if len(after) != len(rs):
+            print(f"{run}: {len(after)} results after, {len(rs)} before", file=sys.stderr)
+            sys.exit(1)
+        with results.open("w") as f:
+            f.writelines(line for line, _ in after)
+        print(f"{run}: {redo} {args.terrain} tasks in {time.time() - start:.0f} s", flush=True)
+
+
+if __name__ == "__main__":
+    main()
