@@ -67,7 +67,8 @@ pub fn run_vehicle(cmd: VehicleCommand) -> CmdResult {
 #[derive(Subcommand)]
 pub enum SimCommand {
     /// Real-time factor of every (or one) vehicle on a high-elevation rigid world with dense
-    /// obstacles and on a deformable world of verti-100 (at the vehicle's scale), single-threaded.
+    /// obstacles, a deformable and a mixed world of verti-100 (at the vehicle's scale),
+    /// single-threaded.
     Bench(BenchArgs),
     /// Random inputs through every world of a set; reports NaNs and blow-ups.
     Soak(SoakArgs),

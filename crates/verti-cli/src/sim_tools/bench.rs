@@ -1,5 +1,5 @@
-//! The speed benchmark behind `verti sim bench`: a scripted driver on a rigid and a soil world
-//! per vehicle scale, timed single-threaded.
+//! The speed benchmark behind `verti sim bench`: a scripted driver on a rigid, a soil and a
+//! mixed world per vehicle scale, timed single-threaded.
 
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -8,7 +8,7 @@ use std::time::Instant;
 use verti_sim::{Controls, Sim, SimState, StartPose, VehicleSpec};
 use verti_world::World;
 
-/// A rigid and a deformable world for one world scale.
+/// A rigid, a deformable and a mixed world for one world scale.
 #[derive(Clone, Debug)]
 pub struct BenchWorldPair {
     pub scale: f64,
@@ -16,6 +16,8 @@ pub struct BenchWorldPair {
     pub rigid: Arc<World>,
     /// Deformable ground (snow, mud and sand patches).
     pub soil: Arc<World>,
+    /// Rigid patches beside soil (where their edges meet the wheels).
+    pub mixed: Arc<World>,
 }
 
 /// The worlds the benchmark drives on, one pair per vehicle scale.
@@ -26,8 +28,8 @@ pub struct BenchWorlds {
 
 impl BenchWorlds {
     /// Worlds of the built-in generated set `verti-100` (seed 0): for each scale, the first
-    /// world that is high-elevation, rigid and dense, and the first deformable world of the
-    /// highest elevation level available. Errors when the generator fails.
+    /// world that is high-elevation, rigid and dense, and the first deformable and the first
+    /// mixed world of the highest elevation level available. Errors when the generator fails.
     pub fn generated(scales: &[f64]) -> Result<BenchWorlds, String> {
         use verti_world::generate::{
             SetConfig, composition, elevation::ProceduralRock, generate_world,
@@ -53,14 +55,17 @@ impl BenchWorlds {
             })
             .or_else(|| pick(&|c| c.1 == TerrainType::Rigid))
             .ok_or("the set has no rigid world")?;
-            let soil = [
-                ElevationLevel::High,
-                ElevationLevel::Mid,
-                ElevationLevel::Low,
-            ]
-            .iter()
-            .find_map(|l| pick(&|c| c.0 == *l && c.1 == TerrainType::Deformable))
-            .ok_or("the set has no deformable world")?;
+            let highest = |kind: TerrainType| {
+                [
+                    ElevationLevel::High,
+                    ElevationLevel::Mid,
+                    ElevationLevel::Low,
+                ]
+                .iter()
+                .find_map(|l| pick(&|c| c.0 == *l && c.1 == kind))
+            };
+            let soil = highest(TerrainType::Deformable).ok_or("the set has no deformable world")?;
+            let mixed = highest(TerrainType::Mixed).ok_or("the set has no mixed world")?;
             let make = |index: u32| {
                 let (l, t, d) = comp[index as usize - 1];
                 generate_world(&config, index, l, t, d, &ProceduralRock::default())
@@ -71,6 +76,7 @@ impl BenchWorlds {
                 scale,
                 rigid: make(rigid)?,
                 soil: make(soil)?,
+                mixed: make(mixed)?,
             });
         }
         Ok(BenchWorlds { pairs })
@@ -94,7 +100,7 @@ impl BenchWorlds {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BenchCase {
     pub vehicle: String,
-    /// `rigid` or `soil`.
+    /// `rigid`, `soil` or `mixed`.
     pub terrain: String,
     pub world: String,
     pub sim_seconds: f64,
@@ -177,7 +183,7 @@ pub fn bench_controls(state: &SimState, target: [f64; 2], scale: f64) -> Control
     }
 }
 
-/// Drives each vehicle for `sim_seconds` on the rigid and the soil world of its scale with
+/// Drives each vehicle for `sim_seconds` on the rigid, the soil and the mixed world of its scale with
 /// [`bench_controls`] along [`bench_route`] at a 50 Hz control rate, `runs` times, single-threaded, and reports the
 /// median real-time factor per case.
 pub fn bench(
@@ -192,7 +198,11 @@ pub fn bench(
         let Some(pair) = worlds.pair_for(spec.scale) else {
             continue;
         };
-        for (terrain, world) in [("rigid", &pair.rigid), ("soil", &pair.soil)] {
+        for (terrain, world) in [
+            ("rigid", &pair.rigid),
+            ("soil", &pair.soil),
+            ("mixed", &pair.mixed),
+        ] {
             let mut rtfs = Vec::new();
             let mut walls = Vec::new();
             let mut error = None;

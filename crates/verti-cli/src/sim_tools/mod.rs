@@ -26,12 +26,12 @@ mod tests {
 
     // `verti sim bench` prints this table; its layout is what users and docs read.
     #[test]
-    fn bench_runs_a_rigid_and_a_soil_case_per_vehicle() {
+    fn bench_runs_a_rigid_a_soil_and_a_mixed_case_per_vehicle() {
         let specs = vec![vehicles::builtin("verti4").unwrap()];
         let worlds = BenchWorlds::generated_for(&specs).unwrap();
         let report = bench(&worlds, &specs, 1.0, 2);
         let kinds: Vec<&str> = report.cases.iter().map(|c| c.terrain.as_str()).collect();
-        assert_eq!(kinds, ["rigid", "soil"]);
+        assert_eq!(kinds, ["rigid", "soil", "mixed"]);
         for c in &report.cases {
             assert_eq!(c.error, None, "{c:?}");
             assert_eq!(c.runs.len(), 2);
@@ -39,7 +39,7 @@ mod tests {
         }
         let text = report.to_string();
         assert!(text.starts_with("vehicle     ground    sim s        RTF   best RTF"));
-        assert_eq!(text.lines().count(), 3);
+        assert_eq!(text.lines().count(), 4);
     }
 
     // A reported episode seed must reproduce the run: everything but the wall time repeats.
