@@ -22,7 +22,6 @@
 //!
 //! Only worlds with both kinds of patch have such sides; elsewhere nothing changes.
 
-use crate::terrain::Ground;
 use verti_core::Vec3;
 use verti_world::World;
 use verti_world::surface::PATCHES_PER_SIDE;
@@ -192,7 +191,7 @@ impl SoilEdges {
     /// is pushed straight back from the side's face.
     pub fn wheel_corner(
         &self,
-        ground: &Ground,
+        height: impl Fn(f64, f64) -> f64,
         hub_patch: usize,
         wheel: Disc,
     ) -> Option<(f64, Vec3, Vec3)> {
@@ -214,9 +213,9 @@ impl SoilEdges {
             // the edge's point in the wheel's plane: from the hub's foot on the edge, along the
             // edge until axle·(c − hub) = 0, at the edge's height there
             let mut c = hub + n_out * d_h;
-            c.z = ground.height(c.x, c.y);
+            c.z = height(c.x, c.y);
             c += along * (-axle.dot(c - hub) / cross);
-            c.z = ground.height(c.x, c.y);
+            c.z = height(c.x, c.y);
             let contact = if c.z >= hub.z {
                 // the wheel's point furthest toward the face, in its plane
                 let u = n_out - axle * axle.dot(n_out);
@@ -289,14 +288,15 @@ mod tests {
     #[test]
     fn a_wheel_in_soil_meets_the_edge_as_a_curb_and_a_higher_one_as_a_wall() {
         let (world, edges) = half_soil();
-        let ground = Ground::new(&world);
+        // the test world is flat at z = 0: the edge's height everywhere
+        let ground = |_: f64, _: f64| 0.0;
         let hub_patch = |hub: Vec3| patch_at(&world, hub.x, hub.y);
         // heading +x (axle along y), radius 0.5, hub 0.3 m west of the edge and 0.3 m up: the
         // wheel is sunk 0.2 m; the edge (0, y, 0) is 0.3√2 from the hub, inside the disc by
         // 0.5 − 0.3√2, and pushes along (−1, 0, 1)/√2
         let hub = Vec3::new(-0.3, 2.0, 0.3);
         let (d, n, arm) = edges
-            .wheel_corner(&ground, hub_patch(hub), (hub, Vec3::Y, 0.5))
+            .wheel_corner(ground, hub_patch(hub), (hub, Vec3::Y, 0.5))
             .expect("the edge is inside the disc");
         let s = std::f64::consts::FRAC_1_SQRT_2;
         assert!((d - (0.5 - 0.3 * 2f64.sqrt())).abs() < 1e-9, "{d}");
@@ -306,7 +306,7 @@ mod tests {
         // how far the disc reaches past the side's face
         let hub = Vec3::new(-0.3, 2.0, -0.1);
         let (d, n, _) = edges
-            .wheel_corner(&ground, hub_patch(hub), (hub, Vec3::Y, 0.5))
+            .wheel_corner(ground, hub_patch(hub), (hub, Vec3::Y, 0.5))
             .unwrap();
         assert!(
             (d - 0.2).abs() < 1e-9 && n == Vec3::new(-1.0, 0.0, 0.0),
@@ -316,13 +316,13 @@ mod tests {
         let hub = Vec3::new(-0.45, 2.0, 0.3);
         assert!(
             edges
-                .wheel_corner(&ground, hub_patch(hub), (hub, Vec3::Y, 0.5))
+                .wheel_corner(ground, hub_patch(hub), (hub, Vec3::Y, 0.5))
                 .is_none()
         );
         let hub = Vec3::new(-0.3, 2.0, 0.3);
         assert!(
             edges
-                .wheel_corner(&ground, hub_patch(hub), (hub, Vec3::X, 0.5))
+                .wheel_corner(ground, hub_patch(hub), (hub, Vec3::X, 0.5))
                 .is_none()
         );
         // a tread point inside the rigid patch next to the edge leaves that contact to the

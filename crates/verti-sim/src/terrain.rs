@@ -110,7 +110,11 @@ impl Terrain {
     pub fn wheel_corner(&self, wheel: Disc) -> Option<(f64, Vec3, Vec3)> {
         let edges = self.soil_edges.as_ref()?;
         let hub = wheel.0;
-        edges.wheel_corner(&self.ground, self.ground.patch_index(hub.x, hub.y), wheel)
+        edges.wheel_corner(
+            |x, y| self.ground.height(x, y),
+            self.ground.patch_index(hub.x, hub.y),
+            wheel,
+        )
     }
 }
 
