@@ -35,6 +35,16 @@ const SOUTH: u8 = 8;
 /// A wheel: hub, axle (unit), radius.
 pub(crate) type Disc = (Vec3, Vec3, f64);
 
+/// A wheel's contact with the top edge of a rigid patch beside the soil its hub is over.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Curb {
+    /// Penetration of the wheel's disc \[m\] and the normal pushing it out (toward the hub).
+    pub depth: f64,
+    pub normal: Vec3,
+    /// Contact point relative to the hub.
+    pub arm: Vec3,
+}
+
 /// For every patch, the sides across which the ground changes kind (row-major, as the patch
 /// grid): a rigid patch's sides bordering soil, a soil patch's sides bordering rigid ground.
 #[derive(Clone, Debug)]
@@ -120,10 +130,10 @@ impl SoilEdges {
             })
     }
 
-    /// The shortest way out of rigid patch `patch` for a point `p` in it that is `depth` under
-    /// its surface along `normal`: that, or the way through a side bordering soil if shorter
-    /// (its depth, and the horizontal normal pointing into the soil). For the hull's and the
-    /// track ends' points.
+    /// The shortest way out of patch `patch` for a point `p` in it that is `depth` under its
+    /// surface along `normal`: that, or, in a rigid patch, the way through a side bordering
+    /// soil if shorter (its depth, and the horizontal normal pointing into the soil). For the
+    /// hull's and the track ends' points.
     #[inline]
     pub fn exit(&self, p: Vec3, patch: usize, depth: f64, normal: Vec3) -> (f64, Vec3) {
         match self.nearest_side(p, patch) {
@@ -185,8 +195,7 @@ impl SoilEdges {
     }
 
     /// A wheel whose hub is over soil (patch `hub_patch`) against the top edges of the rigid
-    /// patches beside it: the deepest contact (depth, normal toward the hub, contact point
-    /// relative to the hub), if any. The edge's point in the wheel's plane is a curb: the disc
+    /// patches beside it: the deepest contact, if any. The edge's point in the wheel's plane is a curb: the disc
     /// is pushed along the line from it to the hub. An edge above the hub is a wall: the disc
     /// is pushed straight back from the side's face.
     pub fn wheel_corner(
@@ -194,12 +203,12 @@ impl SoilEdges {
         height: impl Fn(f64, f64) -> f64,
         hub_patch: usize,
         wheel: Disc,
-    ) -> Option<(f64, Vec3, Vec3)> {
+    ) -> Option<Curb> {
         let (hub, axle, r) = wheel;
         if self.sides[hub_patch] == 0 || self.rigid[hub_patch] {
             return None;
         }
-        let mut best: Option<(f64, Vec3, Vec3)> = None;
+        let mut best: Option<Curb> = None;
         for (d_h, n_out) in self.sides_of(hub, hub_patch) {
             if d_h >= r {
                 continue;
@@ -216,7 +225,7 @@ impl SoilEdges {
             c.z = height(c.x, c.y);
             c += along * (-axle.dot(c - hub) / cross);
             c.z = height(c.x, c.y);
-            let contact = if c.z >= hub.z {
+            let (depth, normal, arm) = if c.z >= hub.z {
                 // the wheel's point furthest toward the face, in its plane
                 let u = n_out - axle * axle.dot(n_out);
                 let un = u.norm();
@@ -235,8 +244,8 @@ impl SoilEdges {
                 let n = v / dist;
                 (r - dist, n, -n * r)
             };
-            if contact.0 > 0.0 && best.is_none_or(|b| contact.0 > b.0) {
-                best = Some(contact);
+            if depth > 0.0 && best.is_none_or(|b| depth > b.depth) {
+                best = Some(Curb { depth, normal, arm });
             }
         }
         best
@@ -295,9 +304,10 @@ mod tests {
         // wheel is sunk 0.2 m; the edge (0, y, 0) is 0.3√2 from the hub, inside the disc by
         // 0.5 − 0.3√2, and pushes along (−1, 0, 1)/√2
         let hub = Vec3::new(-0.3, 2.0, 0.3);
-        let (d, n, arm) = edges
+        let curb = edges
             .wheel_corner(ground, hub_patch(hub), (hub, Vec3::Y, 0.5))
             .expect("the edge is inside the disc");
+        let (d, n, arm) = (curb.depth, curb.normal, curb.arm);
         let s = std::f64::consts::FRAC_1_SQRT_2;
         assert!((d - (0.5 - 0.3 * 2f64.sqrt())).abs() < 1e-9, "{d}");
         assert!((n - Vec3::new(-s, 0.0, s)).norm() < 1e-9, "{n:?}");
@@ -305,9 +315,10 @@ mod tests {
         // hub below the edge (sunk deeper than its radius): a wall, pushed straight back by
         // how far the disc reaches past the side's face
         let hub = Vec3::new(-0.3, 2.0, -0.1);
-        let (d, n, _) = edges
+        let curb = edges
             .wheel_corner(ground, hub_patch(hub), (hub, Vec3::Y, 0.5))
             .unwrap();
+        let (d, n) = (curb.depth, curb.normal);
         assert!(
             (d - 0.2).abs() < 1e-9 && n == Vec3::new(-1.0, 0.0, 0.0),
             "{d} {n:?}"

@@ -5,7 +5,7 @@
 
 use crate::error::SimError;
 use crate::soil::{SOIL_DELTA_FULL_SCALE, SoilLayout};
-use crate::soil_edges::{Disc, SoilEdges};
+use crate::soil_edges::{Curb, Disc, SoilEdges};
 use std::ops::RangeInclusive;
 use std::sync::Arc;
 use verti_core::Vec3;
@@ -61,9 +61,9 @@ impl Terrain {
         })
     }
 
-    /// The shortest way out of rigid ground for a point `p` in patch `patch` that is `depth`
-    /// under its surface along `normal`: that, or sideways through a side the patch shares
-    /// with soil (`soil_edges`).
+    /// The shortest way out of the ground for a point `p` in patch `patch` that is `depth`
+    /// under its surface along `normal`: that, or, in a rigid patch, sideways through a side
+    /// it shares with soil (`soil_edges`).
     #[inline]
     pub fn rigid_exit(&self, p: Vec3, patch: usize, depth: f64, normal: Vec3) -> (f64, Vec3) {
         match &self.soil_edges {
@@ -105,9 +105,9 @@ impl Terrain {
     }
 
     /// A wheel over soil against the top edges of the rigid patches beside it
-    /// (`SoilEdges::wheel_corner`): depth, normal and contact point relative to the hub.
+    /// (`SoilEdges::wheel_corner`).
     #[inline]
-    pub fn wheel_corner(&self, wheel: Disc) -> Option<(f64, Vec3, Vec3)> {
+    pub fn wheel_corner(&self, wheel: Disc) -> Option<Curb> {
         let edges = self.soil_edges.as_ref()?;
         let hub = wheel.0;
         edges.wheel_corner(

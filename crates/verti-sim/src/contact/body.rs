@@ -91,11 +91,8 @@ pub(crate) fn body_contacts(
             }
             let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
             let n = Vec3::new(-gx * nz, -gy * nz, nz);
-            let (depth, n) = if surface.is_deformable() {
-                ((h - p.z) * nz, n)
-            } else {
-                terrain.rigid_exit(*p, patch, (h - p.z) * nz, n)
-            };
+            // (a soil patch has no side to leave through: the surface's way out)
+            let (depth, n) = terrain.rigid_exit(*p, patch, (h - p.z) * nz, n);
             let mu = surface_mu(surface).min(mu_body);
             if apply(*p, n, depth, mu, 1.0, 1.0) {
                 contacts.chassis_terrain_points += 1;

@@ -245,11 +245,14 @@ pub(crate) fn rigid_wheel_contact(
         sum.add_edges(dir * r, -axle * hw, depth, tilt, n, surface_mu(surface));
     }
     // a wheel in soil against the top edge of a rigid patch beside it: a curb
-    if let Some((depth, n, arm)) = terrain.wheel_corner((hub, axle, r)).filter(|_| !m.belted) {
+    if let Some(curb) = (!m.belted)
+        .then(|| terrain.wheel_corner((hub, axle, r)))
+        .flatten()
+    {
         // the rigid patch: just beyond the contact point, away from the hub
-        let at = hub + arm - n * 0.01;
+        let (n, at) = (curb.normal, hub + curb.arm - curb.normal * 0.01);
         let mu = surface_mu(&patches[ground.patch_index(at.x, at.y)].surface);
-        sum.add_edges(arm, -axle * hw, depth, hw * axle.dot(n), n, mu);
+        sum.add_edges(curb.arm, -axle * hw, curb.depth, hw * axle.dot(n), n, mu);
     }
     if !soil_here && terrain.soil.is_some() {
         // the wheel may be sunk in soil with its samples above the undeformed level

@@ -185,11 +185,8 @@ pub(crate) fn track_run_contacts(
                             let nz = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
                             let n = Vec3::new(-gx * nz, -gy * nz, nz);
                             let top = (h - p.z) * nz;
-                            let (depth, face) = if surface.is_deformable() {
-                                (top, n)
-                            } else {
-                                terrain.rigid_exit(p, patch, top, n)
-                            };
+                            // (on soil: the surface's way out, as no side is crossed)
+                            let (depth, face) = terrain.rigid_exit(p, patch, top, n);
                             if depth < top {
                                 // the edge of a rigid patch beside soil pokes into the track:
                                 // along the track's normal, as a rock's edge does

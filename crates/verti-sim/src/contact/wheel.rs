@@ -104,13 +104,15 @@ pub(crate) fn wheel_contact(
             }
         }
         // a wheel in soil against the top edge of a rigid patch beside it: a curb
-        if let Some((depth, normal, _)) = terrain.wheel_corner((hub, axle, r)).filter(|_| !m.belted)
-            && depth > best_depth
+        if let Some(curb) = (!m.belted)
+            .then(|| terrain.wheel_corner((hub, axle, r)))
+            .flatten()
+            && curb.depth > best_depth
         {
             // the rigid patch: just beyond the contact point, away from the hub
-            let at = hub - normal * (r + 0.01);
-            best_depth = depth;
-            best_normal = normal;
+            let at = hub - curb.normal * (r + 0.01);
+            best_depth = curb.depth;
+            best_normal = curb.normal;
             best_mu = surface_mu(&patches[ground.patch_index(at.x, at.y)].surface);
         }
         if !soil_here && terrain.soil.is_some() {
