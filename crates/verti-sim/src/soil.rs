@@ -28,6 +28,13 @@ pub struct Chunk {
     pub plastic: [f32; CHUNK_NODES],
     /// Largest pressure carried so far \[Pa\].
     pub yield_pressure: [f32; CHUNK_NODES],
+    /// Soil heaped onto the node by bulldozing: its undeformed level rose by this much \[m\].
+    pub heap: [f32; CHUNK_NODES],
+    /// Displaced soil waiting to flow on to the node's neighbours (SCM's mass remainder) \[m\].
+    pub remainder: [f32; CHUNK_NODES],
+    /// The highest heap the chunk has held: a bound on how far above the undeformed ground
+    /// its soil may lie.
+    pub max_heap: f32,
 }
 
 impl Default for Chunk {
@@ -35,6 +42,9 @@ impl Default for Chunk {
         Chunk {
             plastic: [0.0; CHUNK_NODES],
             yield_pressure: [0.0; CHUNK_NODES],
+            heap: [0.0; CHUNK_NODES],
+            remainder: [0.0; CHUNK_NODES],
+            max_heap: 0.0,
         }
     }
 }
@@ -110,6 +120,54 @@ impl SoilState {
         let chunk = Arc::make_mut(table[at.0].get_or_insert_with(|| Arc::new(Chunk::default())));
         chunk.plastic[at.1] = plastic as f32;
         chunk.yield_pressure[at.1] = yield_pressure as f32;
+    }
+
+    /// (heap, remainder) of a node; untouched nodes read zero.
+    #[inline]
+    pub fn heap(&self, at: (usize, usize)) -> (f64, f64) {
+        match &self.table[at.0] {
+            Some(c) => (f64::from(c.heap[at.1]), f64::from(c.remainder[at.1])),
+            None => (0.0, 0.0),
+        }
+    }
+
+    /// (plastic sinkage, heap, remainder) of a node in one lookup; untouched nodes read zero.
+    #[inline]
+    pub fn deformation(&self, at: (usize, usize)) -> (f64, f64, f64) {
+        match &self.table[at.0] {
+            Some(c) => (
+                f64::from(c.plastic[at.1]),
+                f64::from(c.heap[at.1]),
+                f64::from(c.remainder[at.1]),
+            ),
+            None => (0.0, 0.0, 0.0),
+        }
+    }
+
+    /// Writes a node's heap and remainder (copy-on-write, as [`SoilState::set_node`]).
+    #[inline]
+    pub fn set_heap(&mut self, at: (usize, usize), heap: f64, remainder: f64) {
+        let table = Arc::make_mut(&mut self.table);
+        let chunk = Arc::make_mut(table[at.0].get_or_insert_with(|| Arc::new(Chunk::default())));
+        chunk.heap[at.1] = heap as f32;
+        chunk.remainder[at.1] = remainder as f32;
+        chunk.max_heap = chunk.max_heap.max(heap as f32);
+    }
+
+    /// A bound on the heaps of nodes `i0..=i1` × `j0..=j1` \[m\]: the highest any chunk they
+    /// lie in has held (zero on undisturbed soil).
+    pub fn max_heap_in(&self, layout: &SoilLayout, (i0, i1, j0, j1): (i64, i64, i64, i64)) -> f64 {
+        let n = 2 * layout.half + 1;
+        let chunk_of = |i: i64| ((i + layout.half).clamp(0, n - 1) as usize) / CHUNK;
+        let mut max = 0.0f32;
+        for cj in chunk_of(j0)..=chunk_of(j1) {
+            for ci in chunk_of(i0)..=chunk_of(i1) {
+                if let Some(c) = &self.table[cj * layout.chunks + ci] {
+                    max = max.max(c.max_heap);
+                }
+            }
+        }
+        f64::from(max)
     }
 
     /// Number of chunks that hold deformation.

@@ -92,6 +92,7 @@ impl Sim {
         let runs = (model.track_runs.as_ref())
             .map(|r| track_run_contacts(terrain, model, r, st, near, &mut spin_base));
         let rigid = spec.tyre.model == TyreModel::Rigid;
+        crate::contact::soil::begin_soil_step();
         if rigid {
             let stage = RigidStage {
                 frame: &frame,
@@ -156,6 +157,10 @@ impl Sim {
                 st.wheels[w].spin_rate = st.group_spin[m.group];
             }
         }
+
+        // ---- soil: what the wheels displaced is heaped around their patches (SCM's
+        // bulldozing, after every wheel's contact as in Chrono) ----
+        crate::contact::soil::bulldoze_step(terrain, &mut st.soil);
 
         if let Some(runs) = &runs {
             runs.apply(&st.group_spin[..model.groups.len()], &mut loads);

@@ -16,6 +16,7 @@ pub(crate) mod belly;
 pub(crate) mod body;
 #[cfg(test)]
 mod body_tests;
+pub(crate) mod bulldozing;
 pub(crate) mod rigid;
 pub(crate) mod soil;
 pub(crate) mod track_run;
