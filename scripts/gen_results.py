@@ -4,6 +4,7 @@
     bash scripts/benchmarks.sh unpack                  # the committed results, uncompressed
     python3 scripts/gen_results.py [VERTI]             # rewrite every generated block
     python3 scripts/gen_results.py [VERTI] --check     # fail if a block is not what the runs give
+    python3 scripts/gen_results.py [VERTI] --page docs/src/results/chrono.md   # only that page
 
 A block in a page under docs/src/ reads
 
@@ -81,12 +82,14 @@ def section(md, name, where):
 
 
 def main():
-    args = [a for a in sys.argv[1:] if a != "--check"]
+    argv = sys.argv[1:]
+    pages = [ROOT / argv[i + 1] for i, a in enumerate(argv[:-1]) if a == "--page"]
+    args = [a for i, a in enumerate(argv) if a not in ("--check", "--page") and (i == 0 or argv[i - 1] != "--page")]
     verti = args[0] if args else str(ROOT / "target/release/verti")
     check = "--check" in sys.argv
     cache, commands, stale, blocks = {}, {}, [], 0
     with tempfile.TemporaryDirectory() as tmp:
-        for page in sorted((ROOT / "docs/src").rglob("*.md")):
+        for page in pages or sorted((ROOT / "docs/src").rglob("*.md")):
             text = page.read_text(encoding="utf-8")
 
             def fill(m, page=page):

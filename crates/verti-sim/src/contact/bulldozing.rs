@@ -336,7 +336,9 @@ fn load(
 /// around it. False when there is no rim (nothing to erode).
 fn heap_on_rim(win: &mut Window, nodes: &[PatchNode], ground: &Ground) -> bool {
     let mut displaced = 0.0;
-    for p in nodes {
+    // (the wheel's own pressed nodes: another wheel's are PRESSED too, and a node this wheel
+    // only touches may be one of them)
+    for p in nodes.iter().filter(|p| p.sigma > 0.0) {
         let Some(k) = win
             .index(p.i, p.j)
             .filter(|&k| win.nodes[k].kind == PRESSED)

@@ -512,6 +512,22 @@ mod rig {
     /// steps: `scripts/chrono/wheel_rig.cpp SOIL V 0 6100`. Its sinkage falls with speed (SCM's
     /// damping on the tread's normal speed) and with the soil heaped ahead of the wheel; without
     /// bulldozing Chrono's wheel sinks 0.158 m in snow at 3 m/s and verti's did 0.173 m.
+    /// The table of docs/src/results/chrono.md ("One wheel rolling on soil"):
+    /// `cargo test -p verti-sim --release --lib rolling_sinkage_table -- --ignored --nocapture`
+    #[test]
+    #[ignore]
+    fn rolling_sinkage_table() {
+        for (name, soil) in [
+            ("snow", SoilParams::SOFT),
+            ("mud", SoilParams::MID),
+            ("sand", SoilParams::HARD),
+        ] {
+            for v in [0.5, 1.0, 2.0, 3.0, 4.0] {
+                println!("{name} {v} m/s: {:.4} m", rolling_sinkage(soil, v, 6100.0));
+            }
+        }
+    }
+
     #[test]
     fn a_rolling_wheel_sinks_as_chronos_scm_wheel() {
         for (soil, v, chrono) in [
