@@ -3,7 +3,8 @@
 # of verti-100: every field of every trial but wall_time (digests in tests/behaviour/,
 # re-recorded for issue 11, when the default HMMWV took rigid tyres and the belly contact, and
 # for issue 34, when soil damping took the wheel surface's speed and the chassis passed through soil,
-# and when the edges between rigid patches and soil became curbs and walls: mixed worlds only).
+# and when the edges between rigid patches and soil became curbs and walls: mixed worlds only;
+# and for SCM's bulldozing: deformable and mixed worlds).
 #
 #   bash scripts/check_behaviour.sh            # pid (CI runs this; ~20 s of evaluation)
 #   bash scripts/check_behaviour.sh pid eh mppi   # all three (mppi takes ~10 min on 2 cores)

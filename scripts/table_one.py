@@ -5,7 +5,8 @@ committed runs `benchmarks/SET/<system>` (after `bash scripts/benchmarks.sh unpa
 
 Rows: outcomes (%), success per elevation level, success and rollover on rigid worlds alone,
 mean |roll| on high elevation (each trial's mean absolute roll, averaged over the trials), then
-the paper's Table I. The best success among the ten is bold.
+the paper's Table I. The best success among the ten is bold; † marks a system whose deformable
+and mixed tasks predate SCM's bulldozing (benchmarks/in-progress/before-bulldozing.txt).
 """
 
 import sys
@@ -37,7 +38,11 @@ def main():
     missing = [s for s, rs in zip(SYSTEMS, runs) if not rs]
     if missing:
         sys.exit(f"table_one: no results for {', '.join(missing)} (bash scripts/benchmarks.sh unpack)")
-    out = ["| | " + " | ".join(NAMES) + " |", "|---|" + "---:|" * len(NAMES)]
+    stale = (ROOT / "benchmarks/in-progress/before-bulldozing.txt")
+    stale = set(stale.read_text().split()) if stale.exists() else set()
+    # † a system whose soil and mixed tasks predate SCM's bulldozing (scripts/stale_runs.py)
+    names = [n + ("†" if f"benchmarks/{set_name}/{s}" in stale else "") for n, s in zip(NAMES, SYSTEMS)]
+    out = ["| | " + " | ".join(names) + " |", "|---|" + "---:|" * len(NAMES)]
 
     def line(label, cells):
         out.append(f"| {label} | " + " | ".join(cells) + " |")
