@@ -470,6 +470,11 @@ mod rig {
     /// to move up and down (explicit Euler, as Chrono applies SCM's forces): the mean sinkage
     /// r − z over 10 m of steady rolling after 2 s at rest, a 1-s run-up and 5 m.
     fn rolling_sinkage(soil: SoilParams, v: f64, load: f64) -> f64 {
+        rolling_sinkage_slip(soil, v, 0.0, load)
+    }
+
+    /// As [`rolling_sinkage`], the wheel spun at v/(r(1 − slip)).
+    fn rolling_sinkage_slip(soil: SoilParams, v: f64, slip: f64, load: f64) -> f64 {
         let spec = crate::vehicles::builtin("hmmwv").unwrap();
         let model = Model::compile(&spec, 1.0);
         let m = &model.wheels[0];
@@ -486,7 +491,7 @@ mod rig {
             let vx = v * ((t - settle) / ramp).clamp(0.0, 1.0);
             let kin = WheelKinematics {
                 hub_velocity: Vec3::new(vx, 0.0, vz),
-                spin: vx / r,
+                spin: vx / (r * (1.0 - slip)),
                 ..WheelKinematics::at_rest(hub)
             };
             let mut c = WheelContact::default();
@@ -508,8 +513,8 @@ mod rig {
     }
 
     /// Chrono 9.0.1's rigid HMMWV wheel (a cylinder of radius 0.467 m and width 0.254 m, 6100 N,
-    /// spun at v/r) rolling over SCM soil with Verti-Bench's parameters and bulldozing, 5 ms
-    /// steps: `scripts/chrono/wheel_rig.cpp SOIL V 0 6100`. Its sinkage falls with speed (SCM's
+    /// spun at v/(r(1 − slip))) rolling over SCM soil with Verti-Bench's parameters and bulldozing, 5 ms
+    /// steps: `scripts/chrono/wheel_rig.cpp SOIL V SLIP 6100`. Its sinkage falls with speed (SCM's
     /// damping on the tread's normal speed) and with the soil heaped ahead of the wheel; without
     /// bulldozing Chrono's wheel sinks 0.158 m in snow at 3 m/s and verti's did 0.173 m.
     /// The table of docs/src/results/chrono.md ("One wheel rolling on soil"):
@@ -525,23 +530,30 @@ mod rig {
             for v in [0.5, 1.0, 2.0, 3.0, 4.0] {
                 println!("{name} {v} m/s: {:.4} m", rolling_sinkage(soil, v, 6100.0));
             }
+            for slip in [0.2, 0.5] {
+                let z = rolling_sinkage_slip(soil, 1.0, slip, 6100.0);
+                println!("{name} 1 m/s, slip {slip}: {z:.4} m");
+            }
         }
     }
 
     #[test]
     fn a_rolling_wheel_sinks_as_chronos_scm_wheel() {
-        for (soil, v, chrono) in [
-            (SoilParams::SOFT, 1.0, 0.2215),
-            (SoilParams::SOFT, 3.0, 0.1240),
-            (SoilParams::MID, 1.0, 0.0502),
-            (SoilParams::MID, 3.0, 0.0426),
-            (SoilParams::HARD, 1.0, 0.0085),
-            (SoilParams::HARD, 3.0, 0.0071),
+        // (soil, speed, slip, Chrono's sinkage): a driven wheel slipping 50 % rides higher
+        for (soil, v, slip, chrono) in [
+            (SoilParams::SOFT, 1.0, 0.0, 0.2215),
+            (SoilParams::SOFT, 3.0, 0.0, 0.1240),
+            (SoilParams::SOFT, 1.0, 0.5, 0.1723),
+            (SoilParams::MID, 1.0, 0.0, 0.0502),
+            (SoilParams::MID, 3.0, 0.0, 0.0426),
+            (SoilParams::MID, 1.0, 0.5, 0.0472),
+            (SoilParams::HARD, 1.0, 0.0, 0.0085),
+            (SoilParams::HARD, 3.0, 0.0, 0.0071),
         ] {
-            let verti = rolling_sinkage(soil, v, 6100.0);
+            let verti = rolling_sinkage_slip(soil, v, slip, 6100.0);
             assert!(
                 (verti - chrono).abs() < 0.003f64.max(0.12 * chrono),
-                "{soil:?} at {v} m/s: verti sinks {verti:.4} m, Chrono {chrono} m"
+                "{soil:?} at {v} m/s, slip {slip}: verti sinks {verti:.4} m, Chrono {chrono} m"
             );
         }
     }
