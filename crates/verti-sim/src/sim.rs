@@ -114,17 +114,17 @@ impl Sim {
             .collect()
     }
 
-    /// Ground height under (x, y) as the vehicle sees it: the undeformed terrain minus the
-    /// plastic soil sinkage at the nearest soil node.
+    /// Ground height under (x, y) as the vehicle sees it: the undeformed terrain plus the soil
+    /// heaped on the nearest soil node, minus its plastic sinkage.
     pub fn ground_height_at(&self, state: &SimState, x: f64, y: f64) -> f64 {
         let (h, gx, gy) = self.terrain.world.terrain.sample(x, y);
         if let Some(layout) = &self.terrain.soil {
             let i = (x / layout.delta).round() as i64;
             let j = (y / layout.delta).round() as i64;
             if let Some(at) = layout.locate(i, j) {
-                let (plastic, _) = state.soil.node(at);
+                let node = state.soil.node(at);
                 let ca = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
-                return h - plastic / ca;
+                return h + node.heap - node.plastic / ca;
             }
         }
         h

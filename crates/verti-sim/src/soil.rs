@@ -87,6 +87,19 @@ impl SoilLayout {
     }
 }
 
+/// What one node remembers (as [`Chunk`] stores it).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NodeState {
+    /// Plastic sinkage along the undeformed normal \[m\].
+    pub plastic: f64,
+    /// Largest pressure carried so far \[Pa\].
+    pub yield_pressure: f64,
+    /// Soil heaped on the node by bulldozing \[m\].
+    pub heap: f64,
+    /// Displaced soil waiting to flow on \[m\].
+    pub remainder: f64,
+}
+
 /// The mutable soil deformation: cheap to clone (one `Arc`).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SoilState {
@@ -101,54 +114,40 @@ impl SoilState {
         }
     }
 
-    /// (plastic sinkage, yield pressure) of a node; untouched nodes read zero.
+    /// Everything a node remembers; untouched nodes read zero.
     #[inline]
-    pub fn node(&self, at: (usize, usize)) -> (f64, f64) {
+    pub fn node(&self, at: (usize, usize)) -> NodeState {
         match &self.table[at.0] {
-            Some(c) => (
-                f64::from(c.plastic[at.1]),
-                f64::from(c.yield_pressure[at.1]),
-            ),
-            None => (0.0, 0.0),
+            Some(c) => NodeState {
+                plastic: f64::from(c.plastic[at.1]),
+                yield_pressure: f64::from(c.yield_pressure[at.1]),
+                heap: f64::from(c.heap[at.1]),
+                remainder: f64::from(c.remainder[at.1]),
+            },
+            None => NodeState::default(),
         }
     }
 
-    /// Writes a node, copying the table and the chunk first if another state shares them.
+    /// The chunk holding node `at`, for writing: copies the table and the chunk first if
+    /// another state shares them.
+    #[inline]
+    fn chunk_mut(&mut self, at: (usize, usize)) -> &mut Chunk {
+        let table = Arc::make_mut(&mut self.table);
+        Arc::make_mut(table[at.0].get_or_insert_with(|| Arc::new(Chunk::default())))
+    }
+
+    /// Writes a node's plastic sinkage and yield pressure.
     #[inline]
     pub fn set_node(&mut self, at: (usize, usize), plastic: f64, yield_pressure: f64) {
-        let table = Arc::make_mut(&mut self.table);
-        let chunk = Arc::make_mut(table[at.0].get_or_insert_with(|| Arc::new(Chunk::default())));
+        let chunk = self.chunk_mut(at);
         chunk.plastic[at.1] = plastic as f32;
         chunk.yield_pressure[at.1] = yield_pressure as f32;
     }
 
-    /// (heap, remainder) of a node; untouched nodes read zero.
-    #[inline]
-    pub fn heap(&self, at: (usize, usize)) -> (f64, f64) {
-        match &self.table[at.0] {
-            Some(c) => (f64::from(c.heap[at.1]), f64::from(c.remainder[at.1])),
-            None => (0.0, 0.0),
-        }
-    }
-
-    /// (plastic sinkage, heap, remainder) of a node in one lookup; untouched nodes read zero.
-    #[inline]
-    pub fn deformation(&self, at: (usize, usize)) -> (f64, f64, f64) {
-        match &self.table[at.0] {
-            Some(c) => (
-                f64::from(c.plastic[at.1]),
-                f64::from(c.heap[at.1]),
-                f64::from(c.remainder[at.1]),
-            ),
-            None => (0.0, 0.0, 0.0),
-        }
-    }
-
-    /// Writes a node's heap and remainder (copy-on-write, as [`SoilState::set_node`]).
+    /// Writes a node's heap and remainder.
     #[inline]
     pub fn set_heap(&mut self, at: (usize, usize), heap: f64, remainder: f64) {
-        let table = Arc::make_mut(&mut self.table);
-        let chunk = Arc::make_mut(table[at.0].get_or_insert_with(|| Arc::new(Chunk::default())));
+        let chunk = self.chunk_mut(at);
         chunk.heap[at.1] = heap as f32;
         chunk.remainder[at.1] = remainder as f32;
         chunk.max_heap = chunk.max_heap.max(heap as f32);
@@ -226,8 +225,9 @@ mod tests {
         assert!(a.shares_storage_with(&b));
         b.set_node(at, 0.07, 2000.0);
         assert!(!a.shares_storage_with(&b));
-        assert_eq!(a.node(at), (0.05f32 as f64, 1000.0));
-        assert_eq!(b.node(at), (0.07f32 as f64, 2000.0));
+        let read = |n: NodeState| (n.plastic, n.yield_pressure);
+        assert_eq!(read(a.node(at)), (0.05f32 as f64, 1000.0));
+        assert_eq!(read(b.node(at)), (0.07f32 as f64, 2000.0));
         assert_eq!(a.touched_chunks(), 1);
         assert!(layout.locate(1000, 0).is_none());
     }

@@ -166,6 +166,16 @@ impl Window {
         n.ground + n.heap - n.sunk
     }
 
+    /// Takes node `k` into the erosion domain if it is soil carrying no pressure and not in it
+    /// yet; true when taken.
+    #[inline]
+    fn claim(&mut self, k: usize) -> bool {
+        let n = &mut self.nodes[k];
+        let take = (n.kind == FREE || n.kind == PULLED) && !n.in_domain;
+        n.in_domain |= take;
+        take
+    }
+
     #[inline]
     fn undeformed(&self, k: usize) -> bool {
         let n = &self.nodes[k];
@@ -304,9 +314,9 @@ fn load(
             let n = &mut win.nodes[r * win.w + c];
             n.kind = FREE;
             n.at = at;
-            let (plastic, heap, remainder) = state.deformation(at);
-            n.heap = heap;
-            n.remainder = remainder;
+            let node = state.node(at);
+            (n.heap, n.remainder) = (node.heap, node.remainder);
+            let plastic = node.plastic;
             if plastic != 0.0 {
                 let (z, gx, gy) = row.get_or_insert_with(|| terrain.ground.row(y)).sample(x);
                 n.ground = z;
@@ -347,9 +357,7 @@ fn heap_on_rim(win: &mut Window, nodes: &[PatchNode], ground: &Ground) -> bool {
         };
         displaced += p.flow;
         for nb in win.neighbours(k).into_iter().flatten() {
-            let n = &mut win.nodes[nb];
-            if (n.kind == FREE || n.kind == PULLED) && !n.in_domain {
-                n.in_domain = true;
+            if win.claim(nb) {
                 win.rim.push(nb);
             }
         }
@@ -369,9 +377,7 @@ fn heap_on_rim(win: &mut Window, nodes: &[PatchNode], ground: &Ground) -> bool {
         for n in 0..win.front.len() {
             let k = win.front[n];
             for nb in win.neighbours(k).into_iter().flatten() {
-                let n = &mut win.nodes[nb];
-                if (n.kind == FREE || n.kind == PULLED) && !n.in_domain {
-                    n.in_domain = true;
+                if win.claim(nb) {
                     win.next.push(nb);
                 }
             }
@@ -480,7 +486,10 @@ mod tests {
             0..nodes.len(),
             [0..0, 0..0],
         );
-        move |i, j| state.heap(layout.locate(i, j).unwrap())
+        move |i, j| {
+            let node = state.node(layout.locate(i, j).unwrap());
+            (node.heap, node.remainder)
+        }
     }
 
     /// One pressed node displacing 4 cm: its four neighbours, the rim, take 1 cm each (SCM's

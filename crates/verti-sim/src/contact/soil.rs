@@ -203,9 +203,9 @@ fn soil_pressure(
             };
             let (z0, gx, gy) = row.sample(x);
             let ca = 1.0 / (1.0 + gx * gx + gy * gy).sqrt();
-            let (heap, _) = soil_state.heap(at);
-            let sinkage = ca * (z0 + heap - t);
-            let (plastic, yield_p) = soil_state.node(at);
+            let node = soil_state.node(at);
+            let (plastic, yield_p) = (node.plastic, node.yield_pressure);
+            let sinkage = ca * (z0 + node.heap - t);
             if sinkage <= plastic {
                 if sinkage > plastic - RAY_REACH * ca {
                     patch.push(PatchNode {
