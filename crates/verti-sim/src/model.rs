@@ -67,6 +67,11 @@ pub(crate) struct WheelModel {
     /// borders soil, the belt spanning the road wheels meets the patch's edge, not the wheel
     /// (`soil_edges`).
     pub belted: bool,
+    /// A belted road wheel on soil: how far ahead of and behind its centre the belt's lower
+    /// run, flat between this road wheel and its neighbours, presses the soil as a plate
+    /// (half the spacing to the next road wheel each way; zero at the run's ends, where the
+    /// belt rises to the sprocket or idler) \[m\]. (0, 0): the wheel's own cylinder only.
+    pub belt_plate: (f64, f64),
 }
 
 /// The coupling of a wheel to the other end of its axle (a beam, an anti-roll bar): the
@@ -284,6 +289,7 @@ impl Model {
                     link_share,
                     jacking,
                     belted: false,
+                    belt_plate: (0.0, 0.0),
                 });
             }
         }
@@ -338,8 +344,18 @@ impl Model {
             body_damping,
         );
         if let Some(runs) = &track_runs {
-            for &w in runs.sides.iter().flat_map(|side| &side.wheels) {
-                wheels[w].belted = true;
+            for side in &runs.sides {
+                // (front to rear)
+                for (k, &w) in side.wheels.iter().enumerate() {
+                    wheels[w].belted = true;
+                    let x = wheels[w].attach.x;
+                    let half_gap = |n: Option<&usize>| {
+                        n.map_or(0.0, |&o| 0.5 * (wheels[o].attach.x - x).abs())
+                    };
+                    let ahead = half_gap(k.checked_sub(1).and_then(|j| side.wheels.get(j)));
+                    let behind = half_gap(side.wheels.get(k + 1));
+                    wheels[w].belt_plate = (ahead, behind);
+                }
             }
         }
         let wheelbase = wheels

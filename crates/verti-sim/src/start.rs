@@ -64,6 +64,22 @@ pub(crate) fn seat(world: &World, spec: &VehicleSpec, start: StartPose) -> Resul
         * GRAVITY;
     let load = weight / spec.wheel_count() as f64;
     let deflection = load / spec.tyre.radial_stiffness;
+    // a track's road wheels bear on soil through the belt's plates (`WheelModel::belt_plate`):
+    // the length of belt each one carries, half the spacing to its neighbours each way
+    let plate_length = |k: usize| {
+        spec.track.and_then(|t| t.runs)?;
+        let x = spec.axles[k].x;
+        let gap = |better: fn(f64, f64) -> bool| {
+            spec.axles
+                .iter()
+                .map(|a| a.x)
+                .filter(|&o| better(o, x))
+                .map(|o| (o - x).abs())
+                .fold(f64::INFINITY, f64::min)
+        };
+        let half = |g: f64| if g.is_finite() { 0.5 * g } else { 0.0 };
+        Some(half(gap(|o, x| o > x)) + half(gap(|o, x| o < x)))
+    };
     let mut z = f64::NEG_INFINITY;
     for (lx, ly, _, k) in &rows {
         let ax = &spec.axles[*k];
@@ -77,8 +93,11 @@ pub(crate) fn seat(world: &World, spec: &VehicleSpec, start: StartPose) -> Resul
         // that first bounce (deep enough to high-centre a HMMWV in snow).
         let sunk = match world.patches.at(hx, hy).surface {
             Surface::Deformable { soil } if world.terrain.contains(hx, hy) => {
-                static_sinkage(load * nz, ax.wheel.width, ax.wheel.radius, &soil)
-                    .min(0.8 * ax.wheel.radius)
+                match plate_length(*k) {
+                    Some(l) if l > 0.0 => plate_sinkage(load * nz, ax.wheel.width, l, &soil),
+                    _ => static_sinkage(load * nz, ax.wheel.width, ax.wheel.radius, &soil),
+                }
+                .min(0.8 * ax.wheel.radius)
             }
             _ => deflection,
         };
@@ -249,6 +268,14 @@ fn static_sinkage(load: f64, b: f64, r: f64, soil: &SoilParams) -> f64 {
     let i = std::f64::consts::PI.sqrt() * libm::tgamma(n + 1.0) / (2.0 * libm::tgamma(n + 1.5));
     let z = load.max(0.0) / (2.0 * b * k * (2.0 * r).sqrt() * i);
     let z = libm::pow(z, 1.0 / (n + 0.5));
+    if z.is_finite() { z } else { 0.0 }
+}
+
+/// Bekker's sinkage of a plate (width b, length l) under `load`: z = (p / (K_c/b + K_φ))^(1/n)
+/// with p = load / (b·l).
+fn plate_sinkage(load: f64, b: f64, l: f64, soil: &SoilParams) -> f64 {
+    let k = soil.bekker_kc / b + soil.bekker_kphi;
+    let z = libm::pow(load.max(0.0) / (b * l) / k, 1.0 / soil.bekker_n);
     if z.is_finite() { z } else { 0.0 }
 }
 

@@ -118,7 +118,7 @@ impl Sim {
 
                 // the spin gets rolling resistance and the soil pressure moment about the axle,
                 // the composite body everything else
-                let axle_moment = contact.soil_moment.dot(kin.axle);
+                let axle_moment = contact.soil_moment.dot(kin.axle) - contact.belt_axle_moment;
                 spin_loads.add_wheel(m.group, tyre.roll_torque + axle_moment, &tyre.long);
                 let mut f_ext = gravity * m.unsprung_mass + contact.force;
                 lateral[w] = contact.force.dot(frame.ey);

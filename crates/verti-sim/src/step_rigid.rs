@@ -64,7 +64,7 @@ impl Sim {
             // Coulomb friction where the rigid contact carries the load, the soil's shear
             // where the soil does (and nothing in the air)
             // the spin gets rolling resistance and the soil pressure moment about the axle
-            let axle_moment = contact.soil_moment.dot(kin.axle);
+            let axle_moment = contact.soil_moment.dot(kin.axle) - contact.belt_axle_moment;
             let mut f_ext = gravity * m.unsprung_mass + contact.force;
             lateral[w] = contact.force.dot(frame.ey);
             // moments reaching the chassis through the bearing: the soil's pressure moment

@@ -82,6 +82,10 @@ pub(crate) struct WheelContact {
     pub soil_length: f64,
     pub soil_janosi_k: f64,
     pub soil_moment: Vec3,
+    /// The part of `soil_moment` about the axle that a track's belt plate carries
+    /// (`soil::BeltPlate`): the hull takes it through the road wheels, not their spin, as the
+    /// belt is not part of the wheel.
+    pub belt_axle_moment: f64,
     pub soil_nodes: u32,
     /// b = 2A/L of this step's soil patch.
     pub soil_b: f64,

@@ -101,6 +101,56 @@ pub(crate) fn bulldoze_step(terrain: &Terrain, soil_state: &mut SoilState) {
     });
 }
 
+/// The flat lower run of a track's belt under one road wheel ([`WheelModel::belt_plate`]): a
+/// plane tangent to the bottom of the wheel, square to the hull's up axis, from `behind` to
+/// `ahead` of the hub along the belt and as wide as the wheel. Between road wheels the belt,
+/// tensioned over them, carries the soil's pressure as a plate, so the track sinks as Bekker's
+/// plate does rather than as separate wheels.
+struct BeltPlate {
+    /// The plate's outward normal (the hull's up axis, square to the axle).
+    normal: Vec3,
+    /// Along the belt, forwards.
+    along: Vec3,
+    ahead: f64,
+    behind: f64,
+    /// max(ahead, behind) \[m\].
+    reach: f64,
+}
+
+impl BeltPlate {
+    /// `None` for a wheel without a plate, or a hull on its side (the plate nearly vertical).
+    fn new(m: &WheelModel, kin: &WheelKinematics) -> Option<BeltPlate> {
+        let (ahead, behind) = m.belt_plate;
+        if ahead <= 0.0 && behind <= 0.0 {
+            return None;
+        }
+        let normal = (kin.up - kin.axle * kin.up.dot(kin.axle)).normalized();
+        if normal.z < 0.3 {
+            return None;
+        }
+        Some(BeltPlate {
+            normal,
+            along: kin.axle.cross(normal),
+            ahead,
+            behind,
+            reach: ahead.max(behind),
+        })
+    }
+
+    /// Height at which the vertical line through (x, y) meets the plate, if it meets it within
+    /// the plate's extent.
+    #[inline]
+    fn height_over(&self, x: f64, y: f64, hub: Vec3, axle: Vec3, m: &WheelModel) -> Option<f64> {
+        let base = hub - self.normal * m.radius;
+        let n = self.normal;
+        let t = base.z - (n.x * (x - base.x) + n.y * (y - base.y)) / n.z;
+        let arm = Vec3::new(x, y, t) - hub;
+        let along = arm.dot(self.along);
+        (along <= self.ahead && along >= -self.behind && arm.dot(axle).abs() <= m.half_width)
+            .then_some(t)
+    }
+}
+
 /// The pressure stage of [`soil_contact`]: the soil's forces on the wheel and the new plastic
 /// sinkage of its nodes; the wheel's patch nodes go to `patch`.
 #[allow(clippy::too_many_arguments)]
@@ -122,24 +172,32 @@ fn soil_pressure(
     let r = m.radius;
     let delta = layout.delta;
     let area = delta * delta;
+    let plate = BeltPlate::new(m, kin);
+    let plate_reach = plate.as_ref().map_or(0.0, |p| p.reach);
+    // the horizontal reach of what can touch the soil: the wheel, or the belt's plate
+    let span = r.max(plate_reach);
     // Footprint bound: the part of the wheel below the highest undeformed level nearby.
     // heaped soil may stand above the undeformed ground, and SCM's rays see the wheel up to
     // RAY_REACH above the soil (the nodes bulldozing may not raise through the wheel)
     let reach = (
-        fast_floor((hub.x - r) / delta) - 1,
-        fast_ceil((hub.x + r) / delta) + 1,
-        fast_floor((hub.y - r) / delta) - 1,
-        fast_ceil((hub.y + r) / delta) + 1,
+        fast_floor((hub.x - span) / delta) - 1,
+        fast_ceil((hub.x + span) / delta) + 1,
+        fast_floor((hub.y - span) / delta) - 1,
+        fast_ceil((hub.y + span) / delta) + 1,
     );
     let ground_max = terrain
         .bound
-        .max_in(hub.x - r, hub.y - r, hub.x + r, hub.y + r)
+        .max_in(hub.x - span, hub.y - span, hub.x + span, hub.y + span)
         + soil_state.max_heap_in(layout, reach);
     let drop = hub.z - ground_max - RAY_REACH;
-    if drop >= r {
+    // (a plate tilted with the hull reaches at most its length lower than the wheel)
+    if drop >= r + plate_reach {
         return;
     }
-    let half_chord = (r * r - drop.max(0.0).powi(2)).sqrt();
+    let half_chord = match &plate {
+        None => (r * r - drop.max(0.0).powi(2)).sqrt(),
+        Some(p) => p.reach.max(r),
+    };
     let fwd = Vec3::Z.cross(axle).normalized();
     let ext_x = half_chord * fwd.x.abs() + m.half_width * axle.x.abs() + 0.5 * delta;
     let ext_y = half_chord * fwd.y.abs() + m.half_width * axle.y.abs() + 0.5 * delta;
@@ -170,21 +228,33 @@ fn soil_pressure(
         let row = ground.row(y);
         for i in i0..=i1 {
             let x = i as f64 * delta;
-            let w = Vec3::new(x - hub.x, y - hub.y, -hub.z);
-            let wa = w.dot(axle);
-            let f = w - axle * wa;
-            let fe = f.dot(e);
-            let disc = fe * fe - ee * (f.norm_sq() - r * r);
-            if disc <= 0.0 {
-                continue;
-            }
-            let t = (-fe - disc.sqrt()) / ee; // lower intersection height
+            // the lowest point over the node: on the belt's plate where that covers the node
+            // (the wheel lies above the plate, which is tangent to its bottom), else on the
+            // wheel's tread
+            let on_plate = plate
+                .as_ref()
+                .and_then(|p| p.height_over(x, y, hub, axle, m));
+            let t = match on_plate {
+                Some(t) => t,
+                None => {
+                    let w = Vec3::new(x - hub.x, y - hub.y, -hub.z);
+                    let wa = w.dot(axle);
+                    let f = w - axle * wa;
+                    let fe = f.dot(e);
+                    let disc = fe * fe - ee * (f.norm_sq() - r * r);
+                    if disc <= 0.0 {
+                        continue;
+                    }
+                    let t = (-fe - disc.sqrt()) / ee; // lower intersection height
+                    let lateral = wa + t * axle.z;
+                    if lateral.abs() > m.half_width {
+                        continue;
+                    }
+                    t
+                }
+            };
             // the wheel is above every terrain height around here: no sinkage possible
             if t >= ground_max + RAY_REACH {
-                continue;
-            }
-            let lateral = wa + t * axle.z;
-            if lateral.abs() > m.half_width {
                 continue;
             }
             let pk = ground.patch_index(x, y);
@@ -251,7 +321,11 @@ fn soil_pressure(
             });
             let fnode = normal * (sigma * area);
             c.force += fnode;
-            c.soil_moment += arm.cross(fnode);
+            let moment = arm.cross(fnode);
+            c.soil_moment += moment;
+            if on_plate.is_some() {
+                c.belt_axle_moment += moment.dot(axle);
+            }
             let nu = normal.dot(up);
             c.k_axis += slope * area * nu * nu;
             c.c_axis += soil.damping * area * nu * nu;
@@ -317,11 +391,22 @@ mod tests {
         (load, sink.iter().cloned().fold(0.0, f64::max))
     }
 
-    /// The HMMWV's wheel pressed quasi-statically into fresh `soil` at `hub` (x, y) until it
-    /// carries `load`: the contact kinematics, the soil state and the patch size reached.
+    /// The model's first wheel pressed quasi-statically into fresh `soil` at `hub` (x, y) until
+    /// it carries `load`: the contact kinematics, the soil state and the patch size reached.
     fn pressed(
         terrain: &Terrain,
         model: &Model,
+        hub: Vec3,
+        load: f64,
+    ) -> (WheelKinematics, SoilState, f64, WheelContact) {
+        pressed_wheel(terrain, model, 0, hub, load)
+    }
+
+    /// [`pressed`] for wheel `w` of the model.
+    fn pressed_wheel(
+        terrain: &Terrain,
+        model: &Model,
+        w: usize,
         mut hub: Vec3,
         load: f64,
     ) -> (WheelKinematics, SoilState, f64, WheelContact) {
@@ -337,7 +422,7 @@ mod tests {
                 terrain,
                 &layout,
                 &mut state,
-                &model.wheels[0],
+                &model.wheels[w],
                 b,
                 &kin,
                 &mut c,
@@ -455,6 +540,64 @@ mod tests {
                 }
                 assert!((z0 - lo).abs() < 2e-5, "{soil:?}: z0 {z0} vs {lo}");
             }
+        }
+    }
+
+    /// A road wheel of the M113 between two others bears on soil through the belt's plate: the
+    /// nodes under a flat rectangle one road-wheel spacing long (0.667 m) and the track's width
+    /// (0.413 m), all at the plate's depth. Pressed quasi-statically until it carries 10 kN, it
+    /// sinks as the node grid carries Bekker's pressure over that rectangle (the nodes whose
+    /// centres it covers), to the 0.01 mm steps; no pressure moment reaches the road wheel's
+    /// spin (the belt is not part of the wheel), all of it is the belt's.
+    #[test]
+    fn a_road_wheel_bears_on_soil_through_the_belt_plate() {
+        let spec = crate::vehicles::builtin("m113").unwrap();
+        let model = Model::compile(&spec, 1.0);
+        let w = 2; // the second road wheel on the left
+        let m = &model.wheels[w];
+        let (ahead, behind) = m.belt_plate;
+        assert!(
+            (ahead - 0.3335).abs() < 1e-9 && (behind - 0.3335).abs() < 1e-9,
+            "{ahead} {behind}"
+        );
+        let (first, last) = (model.wheels[0].belt_plate, model.wheels[8].belt_plate);
+        assert!(first.0 == 0.0 && last.1 == 0.0, "{first:?} {last:?}");
+        let (r, load) = (m.radius, 10_000.0);
+        for (name, soil) in [
+            ("snow", SoilParams::SOFT),
+            ("mud", SoilParams::MID),
+            ("sand", SoilParams::HARD),
+        ] {
+            let world = Arc::new(crate::testing::soil_world(1.0, soil, 0.0));
+            let terrain = Terrain::new(&world, model.reach).unwrap();
+            let hub = Vec3::new(0.03, 0.02, r);
+            let (kin, _, _, c) = pressed_wheel(&terrain, &model, w, hub, load);
+            let z0 = r - kin.hub.z;
+            let d = 0.1;
+            let count =
+                |lo: f64, hi: f64| ((lo / d).ceil() as i64..=(hi / d).floor() as i64).count();
+            let nodes = count(kin.hub.x - behind, kin.hub.x + ahead)
+                * count(kin.hub.y - m.half_width, kin.hub.y + m.half_width);
+            let (length, width) = (ahead + behind, 2.0 * m.half_width);
+            let b = c.soil_b;
+            let k = soil.bekker_kc / b + soil.bekker_kphi;
+            let carried = nodes as f64 * d * d * k * z0.powf(soil.bekker_n);
+            assert_eq!(c.soil_nodes as usize, nodes, "{soil:?}");
+            assert!(
+                (c.force.z - carried).abs() < 0.01 * carried,
+                "{soil:?}: {} N carried, {carried} N on paper",
+                c.force.z
+            );
+            assert!((c.sinkage - z0).abs() < 1e-9, "{} vs {z0}", c.sinkage);
+            assert!(
+                (c.soil_moment.dot(kin.axle) - c.belt_axle_moment).abs() < 1e-9,
+                "{soil:?}: {} of the moment about the axle is not the belt's",
+                c.soil_moment.dot(kin.axle) - c.belt_axle_moment
+            );
+            println!(
+                "{name}: {length:.3} x {width:.3} m plate, {nodes} nodes, {z0:.4} m under {:.0} N",
+                c.force.z
+            );
         }
     }
 }
