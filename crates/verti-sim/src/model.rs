@@ -345,16 +345,9 @@ impl Model {
         );
         if let Some(runs) = &track_runs {
             for side in &runs.sides {
-                // (front to rear)
-                for (k, &w) in side.wheels.iter().enumerate() {
+                for &w in &side.wheels {
                     wheels[w].belted = true;
-                    let x = wheels[w].attach.x;
-                    let half_gap = |n: Option<&usize>| {
-                        n.map_or(0.0, |&o| 0.5 * (wheels[o].attach.x - x).abs())
-                    };
-                    let ahead = half_gap(k.checked_sub(1).and_then(|j| side.wheels.get(j)));
-                    let behind = half_gap(side.wheels.get(k + 1));
-                    wheels[w].belt_plate = (ahead, behind);
+                    wheels[w].belt_plate = spec.belt_plate(w / 2);
                 }
             }
         }

@@ -64,21 +64,10 @@ pub(crate) fn seat(world: &World, spec: &VehicleSpec, start: StartPose) -> Resul
         * GRAVITY;
     let load = weight / spec.wheel_count() as f64;
     let deflection = load / spec.tyre.radial_stiffness;
-    // a track's road wheels bear on soil through the belt's plates (`WheelModel::belt_plate`):
-    // the length of belt each one carries, half the spacing to its neighbours each way
+    // a track's road wheels bear on soil through the belt's plates (`WheelModel::belt_plate`)
     let plate_length = |k: usize| {
-        spec.track.and_then(|t| t.runs)?;
-        let x = spec.axles[k].x;
-        let gap = |better: fn(f64, f64) -> bool| {
-            spec.axles
-                .iter()
-                .map(|a| a.x)
-                .filter(|&o| better(o, x))
-                .map(|o| (o - x).abs())
-                .fold(f64::INFINITY, f64::min)
-        };
-        let half = |g: f64| if g.is_finite() { 0.5 * g } else { 0.0 };
-        Some(half(gap(|o, x| o > x)) + half(gap(|o, x| o < x)))
+        let (ahead, behind) = spec.belt_plate(k);
+        ahead + behind
     };
     let mut z = f64::NEG_INFINITY;
     for (lx, ly, _, k) in &rows {
@@ -94,7 +83,7 @@ pub(crate) fn seat(world: &World, spec: &VehicleSpec, start: StartPose) -> Resul
         let sunk = match world.patches.at(hx, hy).surface {
             Surface::Deformable { soil } if world.terrain.contains(hx, hy) => {
                 match plate_length(*k) {
-                    Some(l) if l > 0.0 => plate_sinkage(load * nz, ax.wheel.width, l, &soil),
+                    l if l > 0.0 => plate_sinkage(load * nz, ax.wheel.width, l, &soil),
                     _ => static_sinkage(load * nz, ax.wheel.width, ax.wheel.radius, &soil),
                 }
                 .min(0.8 * ax.wheel.radius)

@@ -290,21 +290,27 @@ pub fn polygon_signed_distance(poly: &[[f64; 2]], x: f64, y: f64) -> f64 {
     for i in 0..n {
         let a = poly[i];
         let b = poly[(i + 1) % n];
-        let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
-        let (px, py) = (x - a[0], y - a[1]);
-        let len2 = ex * ex + ey * ey;
-        let t = if len2 > 0.0 {
-            ((px * ex + py * ey) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let (dx, dy) = (px - t * ex, py - t * ey);
-        best = best.min((dx * dx + dy * dy).sqrt());
-        if ex * py - ey * px < 0.0 {
+        best = best.min(segment_distance(a, b, [x, y]));
+        // Counter-clockwise polygon: a point right of any edge is outside.
+        if (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]) < 0.0 {
             inside = false;
         }
     }
     if inside { -best } else { best }
+}
+
+/// Distance from point `p` to the segment from `a` to `b` (to `a` when the segment is a point).
+pub fn segment_distance(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
+    let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
+    let (px, py) = (p[0] - a[0], p[1] - a[1]);
+    let len2 = ex * ex + ey * ey;
+    let t = if len2 > 0.0 {
+        ((px * ex + py * ey) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (dx, dy) = (px - t * ex, py - t * ey);
+    (dx * dx + dy * dy).sqrt()
 }
 
 /// The six faces of an axis-aligned box with the given full sizes, centred at the origin.

@@ -10,7 +10,7 @@
 //! shortcuts are checked against the exact clearance, so the final path never enters an
 //! inflated obstacle.
 
-use crate::obstacle::Obstacle;
+use crate::obstacle::{Obstacle, segment_distance};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -114,18 +114,26 @@ impl<'a> PlanningGrid<'a> {
     /// them all gives. Path shortcutting tests thousands of segments per path, and this was
     /// most of the time it takes to build a world set.
     pub fn segment_clear(&self, a: [f64; 2], b: [f64; 2]) -> bool {
+        self.segment_clear_in(a, b, &mut Vec::new())
+    }
+
+    /// [`Self::segment_clear`] gathering the nearby obstacles in `near`, a buffer the caller
+    /// keeps across the thousands of segments path shortcutting tests.
+    fn segment_clear_in<'s>(
+        &'s self,
+        a: [f64; 2],
+        b: [f64; 2],
+        near: &mut Vec<&'s Obstacle>,
+    ) -> bool {
         let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
         let steps = (len / (0.2 * self.cell)).ceil().max(1.0) as usize;
         let step = len / steps as f64;
         let needed = self.clearance + 0.5 * step;
-        let near: Vec<&Obstacle> = self
-            .obstacles
-            .iter()
-            .filter(|o| {
-                let p = o.position();
-                segment_distance(a, b, [p.x, p.y]) - o.radius_xy() < needed + 1e-3
-            })
-            .collect();
+        near.clear();
+        near.extend(self.obstacles.iter().filter(|o| {
+            let p = o.position();
+            segment_distance(a, b, [p.x, p.y]) - o.radius_xy() < needed + 1e-3
+        }));
         let reach = self.clearance + self.cell;
         (0..=steps).all(|i| {
             let t = i as f64 / steps as f64;
@@ -223,10 +231,11 @@ impl<'a> PlanningGrid<'a> {
             return pts.to_vec();
         }
         let mut out = vec![pts[0]];
+        let mut near = Vec::new();
         let mut i = 0;
         while i < pts.len() - 1 {
             let mut j = i + 1;
-            while j + 1 < pts.len() && self.segment_clear(pts[i], pts[j + 1]) {
+            while j + 1 < pts.len() && self.segment_clear_in(pts[i], pts[j + 1], &mut near) {
                 j += 1;
             }
             out.push(pts[j]);
@@ -240,19 +249,6 @@ impl<'a> PlanningGrid<'a> {
         let raw = self.astar(start, goal)?;
         Some(resample(&self.shortcut(&raw), self.cell))
     }
-}
-
-/// Distance from point `p` to the segment from `a` to `b`.
-fn segment_distance(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
-    let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
-    let (px, py) = (p[0] - a[0], p[1] - a[1]);
-    let len2 = ex * ex + ey * ey;
-    let t = if len2 > 0.0 {
-        ((px * ex + py * ey) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    ((px - t * ex).powi(2) + (py - t * ey).powi(2)).sqrt()
 }
 
 /// Resamples a polyline at (at most) `spacing`, keeping every corner.

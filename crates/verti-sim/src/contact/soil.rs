@@ -115,6 +115,11 @@ struct BeltPlate {
     behind: f64,
     /// max(ahead, behind) \[m\].
     reach: f64,
+    /// The plate's point under the hub (the wheel's bottom).
+    base: Vec3,
+    hub: Vec3,
+    axle: Vec3,
+    half_width: f64,
 }
 
 impl BeltPlate {
@@ -134,19 +139,23 @@ impl BeltPlate {
             ahead,
             behind,
             reach: ahead.max(behind),
+            base: kin.hub - normal * m.radius,
+            hub: kin.hub,
+            axle: kin.axle,
+            half_width: m.half_width,
         })
     }
 
     /// Height at which the vertical line through (x, y) meets the plate, if it meets it within
     /// the plate's extent.
     #[inline]
-    fn height_over(&self, x: f64, y: f64, hub: Vec3, axle: Vec3, m: &WheelModel) -> Option<f64> {
-        let base = hub - self.normal * m.radius;
-        let n = self.normal;
+    fn height_over(&self, x: f64, y: f64) -> Option<f64> {
+        let (n, base) = (self.normal, self.base);
         let t = base.z - (n.x * (x - base.x) + n.y * (y - base.y)) / n.z;
-        let arm = Vec3::new(x, y, t) - hub;
+        let arm = Vec3::new(x, y, t) - self.hub;
         let along = arm.dot(self.along);
-        (along <= self.ahead && along >= -self.behind && arm.dot(axle).abs() <= m.half_width)
+        let across = arm.dot(self.axle);
+        (along <= self.ahead && along >= -self.behind && across.abs() <= self.half_width)
             .then_some(t)
     }
 }
@@ -231,9 +240,7 @@ fn soil_pressure(
             // the lowest point over the node: on the belt's plate where that covers the node
             // (the wheel lies above the plate, which is tangent to its bottom), else on the
             // wheel's tread
-            let on_plate = plate
-                .as_ref()
-                .and_then(|p| p.height_over(x, y, hub, axle, m));
+            let on_plate = plate.as_ref().and_then(|p| p.height_over(x, y));
             let t = match on_plate {
                 Some(t) => t,
                 None => {

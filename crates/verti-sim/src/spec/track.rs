@@ -91,3 +91,27 @@ impl TrackRunsSpec {
         Ok(())
     }
 }
+
+impl super::VehicleSpec {
+    /// The belt's plate under road wheel pair `axle` (`WheelModel::belt_plate`): how far the
+    /// flat lower run it carries reaches ahead of and behind its hub \[m\], half the spacing to
+    /// the next road wheel each way (none beyond the end wheels, whose own tread carries
+    /// outwards). `(0, 0)` for a vehicle without track runs, whose road wheels bear as wheels.
+    pub fn belt_plate(&self, axle: usize) -> (f64, f64) {
+        if self.track.and_then(|t| t.runs).is_none() {
+            return (0.0, 0.0);
+        }
+        let x = self.axles[axle].x;
+        let half_gap = |beyond: fn(f64, f64) -> bool| {
+            let gap = self
+                .axles
+                .iter()
+                .map(|a| a.x)
+                .filter(|&o| beyond(o, x))
+                .map(|o| (o - x).abs())
+                .fold(f64::INFINITY, f64::min);
+            if gap.is_finite() { 0.5 * gap } else { 0.0 }
+        };
+        (half_gap(|o, x| o > x), half_gap(|o, x| o < x))
+    }
+}
