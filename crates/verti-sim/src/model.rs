@@ -13,6 +13,7 @@
 //! chassis z axis, which is how vehicles are described here.
 
 use crate::spec::{Differential, SolidAxleSpec, VehicleSpec};
+use crate::state::WheelState;
 use crate::track_runs::TrackRuns;
 use verti_core::Vec3;
 
@@ -72,6 +73,8 @@ pub(crate) struct WheelModel {
     /// (half the spacing to the next road wheel each way; zero at the run's ends, where the
     /// belt rises to the sprocket or idler) \[m\]. (0, 0): the wheel's own cylinder only.
     pub belt_plate: (f64, f64),
+    /// How the wheel's plane tilts with its travel (camber, or a beam axle's roll).
+    pub tilt: WheelTilt,
 }
 
 /// The coupling of a wheel to the other end of its axle (a beam, an anti-roll bar): the
@@ -84,6 +87,43 @@ pub(crate) struct AxleCoupling {
     /// A beam with its own roll inertia: the (diagonal, off-diagonal) terms of the two travels'
     /// mass matrix ([`crate::spec::BeamSpec::mass_matrix`]); the pair is then updated together.
     pub beam: Option<(f64, f64)>,
+}
+
+/// How a wheel's spin axis tilts away from square to the chassis, as a rotation about the
+/// chassis' x axis (positive lifts the axle's left end). The hub still moves straight along the
+/// chassis' up axis; only the wheel's plane turns, so a rigid tyre bears on the edge its
+/// suspension tips down.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum WheelTilt {
+    /// Always square (a wheel sliding straight up and down).
+    Square,
+    /// An independent linkage's camber change: tilt `per_metre`·(s − `rest`) for travel s
+    /// (`per_metre` signed by side, so that both wheels' tops lean the same way relative to the
+    /// chassis' centre line at equal travel).
+    Camber { per_metre: f64, rest: f64 },
+    /// One end of a beam axle: square to the beam, which rolls by atan((s_l − s_r)/t) relative
+    /// to the chassis; `side_over_track` is ±1/t (+ on the left).
+    Beam {
+        partner: usize,
+        side_over_track: f64,
+    },
+}
+
+impl WheelTilt {
+    /// The tilt \[rad\] with the wheels' travels of `wheels`; `None` when square.
+    #[inline]
+    pub(crate) fn angle(&self, own: f64, wheels: &[WheelState]) -> Option<f64> {
+        match *self {
+            WheelTilt::Square => None,
+            WheelTilt::Camber { per_metre, rest } => Some(per_metre * (own - rest)),
+            WheelTilt::Beam {
+                partner,
+                side_over_track,
+            } => Some(libm::atan(
+                side_over_track * (own - wheels[partner].compression),
+            )),
+        }
+    }
 }
 
 /// Wheels that share one spin degree of freedom (a track's side, or a locked differential).
@@ -290,6 +330,18 @@ impl Model {
                     jacking,
                     belted: false,
                     belt_plate: (0.0, 0.0),
+                    tilt: match (&ax.solid_axle, ax.camber_gain_deg_per_m) {
+                        (Some(_), _) => WheelTilt::Beam {
+                            partner: w ^ 1,
+                            side_over_track: side / ax.track,
+                        },
+                        // a rising left wheel whose top tips inwards turns about +x
+                        (None, Some(g)) => WheelTilt::Camber {
+                            per_metre: -side * g.to_radians(),
+                            rest: comp[k],
+                        },
+                        (None, None) => WheelTilt::Square,
+                    },
                 });
             }
         }

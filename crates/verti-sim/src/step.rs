@@ -68,6 +68,19 @@ impl Sim {
         state.check(scale)
     }
 
+    /// Each wheel's spin axis in the world frame (pointing to the wheel's left): steered, and
+    /// tilted by its camber or its beam axle's roll, as the contacts see it.
+    pub fn wheel_axles(&self, state: &SimState) -> Vec<Vec3> {
+        let frame = Frame::of(state);
+        let steer = drivetrain::wheel_steer(&self.spec, &self.model, state.steer);
+        self.model
+            .wheels
+            .iter()
+            .zip(&state.wheels)
+            .map(|(m, ws)| frame.wheel(state, m, ws, &steer).axle)
+            .collect()
+    }
+
     /// One internal step: driver inputs, wheel forces, spins, body contacts, integration.
     fn substep(&self, st: &mut SimState, ctl: &Controls, h: f64) {
         let (spec, model, terrain) = (&self.spec, &self.model, &self.terrain);
@@ -299,10 +312,15 @@ impl Frame {
     ) -> WheelKinematics {
         let (sin_steer, cos_steer) = drivetrain::steer_sin_cos(m, steer);
         let arm = self.q.rotate(m.attach + Vec3::Z * ws.compression);
+        // the wheel's plane tilts about the chassis' x axis, steered or not
+        let lateral = match m.tilt.angle(ws.compression, &st.wheels) {
+            None => self.ey,
+            Some(tilt) => self.ey * libm::cos(tilt) + self.up * libm::sin(tilt),
+        };
         WheelKinematics {
             arm,
             hub: st.position + arm,
-            axle: self.ex * (-sin_steer) + self.ey * cos_steer,
+            axle: self.ex * (-sin_steer) + lateral * cos_steer,
             hub_velocity: st.velocity + self.omega.cross(arm) + self.up * ws.compression_rate,
             up: self.up,
             chassis_omega: self.omega,

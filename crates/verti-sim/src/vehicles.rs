@@ -94,12 +94,16 @@ pub struct Mechanisms {
 pub fn mechanisms(name: &str) -> Option<Mechanisms> {
     let hmmwv = Mechanisms {
         chassis: "4-wheeled",
-        suspension_families: &["double wishbone"],
-        steering_families: &["pitman arm"],
+        // neither linkage's geometry is simulated for it, so it claims no family of the paper
+        suspension_families: &[],
+        steering_families: &[],
         suspension: "double wishbone (Chrono's reduced double-A-arm), modelled as independent wheels \
                      sliding straight up and down (roll centre on the ground; Chrono's linkage puts \
                      it 0.354 m front, 0.407 m rear above the ground: not adopted, see the engine docs)",
-        steering: "Pitman arm, modelled as Ackermann geometry up to the 30.23° road-wheel angle",
+        steering: "ideal Ackermann geometry up to 30.23°, the road-wheel angle of Chrono's JSON \
+                   HMMWV (Chrono's HMMWV steers by a Pitman arm, the HMMWV_Reduced Verti-Bench \
+                   drives by a rack and pinion with a 21.7° bicycle angle at full input; neither \
+                   linkage is modelled for it: see the engine docs)",
         source: "Chrono 9.0.1 HMMWV_Reduced as Verti-Bench uses it (physics_spec §3.1)",
     };
     let man = |chassis, steering| Mechanisms {
@@ -107,8 +111,8 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
         suspension_families: &["multilink"],
         steering_families: &["bellcrank/rotary arm"],
         suspension: "solid three-link axles after Chrono's MAN Kat1: each axle one beam (springs \
-                     1.18 m apart in front, 1.31 m at the rear), roll centres at the triangle link's \
-                     apex, 0.89 m above the ground",
+                     1.18 m apart in front, 1.31 m at the rear) whose wheels stay square to it as \
+                     it rolls, roll centres at the triangle link's apex, 0.89 m above the ground",
         steering,
         source: "Chrono MAN Kat1 chassis and layout (physics_spec §3.3); springs, tyres, engine chosen",
     };
@@ -119,14 +123,15 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension_families: &["double wishbone"],
             steering_families: &["pitman arm"],
             suspension: "double wishbone: independent wheels with the linkage's roll centre, \
-                         0.029 m above the ground (camber change not modelled)",
+                         0.029 m above the ground, and its camber change, -42.6°/m of travel",
             steering: "Pitman arm and idler: each wheel's angle from the linkage's geometry",
             source: "Chrono ARTcar (physics_spec §3.2); COM, wheel rate, motor voltage chosen",
         },
         "verti4" => Mechanisms {
             chassis: "4-wheeled, 1/10 scale",
-            suspension_families: &["multilink"],
-            steering_families: &["bellcrank/rotary arm"],
+            // no public geometry: it claims no family of the paper
+            suspension_families: &[],
+            steering_families: &[],
             suspension: "solid three-link (multi-link beam) axles, modelled as independent wheels \
                          (no public suspension geometry of this vehicle)",
             steering: "rotary arm / bellcrank, modelled as Ackermann geometry",
@@ -162,8 +167,9 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension_families: &["toe-bar leaf-spring"],
             steering_families: &["toe-bar", "bellcrank/rotary arm"],
             suspension: "leaf-spring solid axles (toe-bar axle in front), modelled as solid axles: \
-                         wheels coupled through springs 1.028 m and dampers 0.882 m apart, roll \
-                         centres at the axle tube's guide, 0.372 m above the ground",
+                         wheels coupled through springs 1.028 m and dampers 0.882 m apart and square \
+                         to the beam as it rolls, roll centres at the axle tube's guide, 0.372 m \
+                         above the ground",
             steering: "toe-bar axle steered by a drag link from a rotary Pitman arm: each wheel's \
                        angle from the linkage's geometry (left and right locks differ)",
             source: "Chrono UAZ469 / UAZBUS (data/vehicle/uaz, src/chrono_models/vehicle/uaz)",
@@ -173,8 +179,9 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension_families: &["single wishbone"],
             steering_families: &["rack-and-pinion"],
             suspension: "single wishbone (swing arm) in front: wheel rate from the strut's motion \
-                         ratio 0.62, roll centre at the arm's pivot line, 0.342 m above the ground; \
-                         rigid rear axle (a spring as stiff as the step allows)",
+                         ratio 0.62, roll centre at the arm's pivot line, 0.342 m above the ground, \
+                         the wheel tilting with the 0.5-m arm (camber -114.6°/m of travel); rigid \
+                         rear axle (a spring as stiff as the step allows)",
             steering: "rack and pinion: each wheel's angle from the linkage's geometry (parallel \
                        steer)",
             source: "Chrono Gator (src/chrono_models/vehicle/gator, data/vehicle/gator/json)",
@@ -186,7 +193,8 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
             suspension: "double wishbone in front, multilink rear (upper A-arm, lateral, trailing \
                          and toe links): independent wheels at their wheel rates (coil motion ratios \
                          0.519 front, 0.612 rear, by virtual work) with the linkages' roll centres, \
-                         0.164 m front and 0.043 m rear above the ground (camber change not modelled)",
+                         0.164 m front and 0.043 m rear above the ground, and their camber \
+                         change, -19.3°/m front and -30.2°/m rear",
             steering: "rack and pinion: each wheel's angle from the linkage's geometry \
                        (anti-Ackermann)",
             source: "Chrono Sedan, C++ model (src/chrono_models/vehicle/sedan)",
@@ -289,7 +297,7 @@ impl VehicleSpec {
             if let Some(sa) = &a.solid_axle {
                 let _ = writeln!(
                     s,
-                    "          solid axle: springs {:.3} m apart, dampers {:.3} m apart (roll rate {:.0} % of heave)",
+                    "          solid axle: springs {:.3} m apart, dampers {:.3} m apart (roll rate {:.0} % of heave), wheels square to the beam",
                     sa.spring_track,
                     sa.damper_track,
                     100.0 * (sa.spring_track / a.track).powi(2)
@@ -306,6 +314,13 @@ impl VehicleSpec {
                 let _ = writeln!(
                     s,
                     "          roll centre {h:.3} m above the ground (the links carry F_y·{h:.3} m of the roll moment of the axle's lateral force F_y)"
+                );
+            }
+            if let Some(g) = a.camber_gain_deg_per_m {
+                let _ = writeln!(
+                    s,
+                    "          camber change {g:.1}°/m of wheel travel from rest (a {:.2}-m swing arm in front view)",
+                    1.0 / g.to_radians().abs()
                 );
             }
             if let Some(bar) = &a.anti_roll_bar {

@@ -63,6 +63,18 @@ fn every_scale_chassis_suspension_and_steering_family_is_shipped() {
             "no {family} steering"
         );
     }
+    // a family is claimed only where its mechanism is simulated: a steering family needs the
+    // linkage's geometry (or skid steering), not ideal Ackermann geometry
+    for (spec, m) in specs.iter().zip(&mechs) {
+        if spec.steering.kind == verti_sim::spec::SteeringKind::Ackermann && !spec.is_tracked() {
+            assert!(
+                m.steering_families.is_empty(),
+                "{} claims {:?} but steers by ideal Ackermann geometry",
+                spec.name,
+                m.steering_families
+            );
+        }
+    }
     // the summary of a built-in says what it is; an edited copy does not claim to be it
     let uaz = vehicles::builtin("uaz").unwrap();
     assert!(uaz.summary().contains("toe-bar"), "{}", uaz.summary());
