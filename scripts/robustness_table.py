@@ -1,4 +1,4 @@
-"""The robustness tables of the documentation (docs/src/results/robustness.md): success (%) per system at each perception preset.
+"""The robustness tables of the documentation (docs/src/results/robustness.md): success (%) per system at each perception preset, and the split of `high` into its map and state errors.
 
     bash scripts/benchmarks.sh unpack && python3 scripts/robustness_table.py
 
@@ -96,6 +96,28 @@ def main(root):
         runs = [full_run(root, p, s) for p in PRESETS]
         cells = [cell(success(run, SUBSET), 100, 0) for run in runs]
         print(f"| `{s}` | " + " | ".join(cells) + f" | {lost_gained(runs[0], runs[-1], SUBSET)} |")
+    # which part of `high` costs: its map errors alone (`high-without-pose`, an exact state
+    # estimate) and its state errors alone (`high-without-map`, the true map)
+    ablation = root / "perception-ablation"
+    print()
+    print("| system | none | `high` | map errors only | state errors only |")
+    print("|---|---:|---:|---:|---:|")
+    split = [ablation / "high-without-pose", ablation / "high-without-map"]
+    for s in full:
+        if not all((part / s).is_dir() for part in split):
+            continue
+        runs = [full_run(root, "none", s), full_run(root, "high", s)] + [part / s for part in split]
+        cells = [cell(success(run), 1000, 1) for run in runs]
+        print(f"| `{s}` (1000 tasks) | " + " | ".join(cells) + " |")
+    for s in sorted({r.name.removesuffix("-sub100") for r in split[0].glob("*-sub100")}, key=order):
+        if not all((part / f"{s}-sub100").is_dir() for part in split):
+            continue
+        high = root / "perception-high" / f"{s}-sub100"
+        if not high.is_dir():
+            high = full_run(root, "high", s)  # a fast system's 1000-task run, on the same tasks
+        runs = [full_run(root, "none", s), high] + [part / f"{s}-sub100" for part in split]
+        cells = [cell(success(run, SUBSET), 100, 0) for run in runs]
+        print(f"| `{s}` (100 tasks) | " + " | ".join(cells) + " |")
 
 
 if __name__ == "__main__":
