@@ -21,7 +21,7 @@ use verti_core::Rng;
 pub struct MppiParams {
     /// Rollouts per plan.
     pub samples: usize,
-    /// Horizon steps and their duration (s).
+    /// Horizon steps and their duration (s at full scale, scaled by √s).
     pub horizon: usize,
     pub step: f64,
     /// Temperature λ.
@@ -138,7 +138,9 @@ impl Mppi {
             local_goal,
             samples: k,
             horizon: h,
-            step: p.step,
+            // speeds scale by √s and lengths by s, so times by √s: the rollouts then reach as
+            // far ahead, relative to the vehicle and the look-ahead, at every scale
+            step: p.step * self.scale.sqrt(),
             nominal_speed: v_nom,
             speed_range: (v_lo, v_hi),
             lambda: p.lambda,

@@ -102,7 +102,13 @@ pub fn mppi_params() -> Vec<ParamSpec> {
     vec![
         ParamSpec::int("samples", m.samples as i64, 1, 65536, "rollouts per plan"),
         ParamSpec::int("horizon", m.horizon as i64, 1, 1000, "rollout steps"),
-        ParamSpec::float("step", m.step, 0.01, 1.0, "rollout step, s"),
+        ParamSpec::float(
+            "step",
+            m.step,
+            0.01,
+            1.0,
+            "rollout step at full scale, s (scaled by sqrt(world scale))",
+        ),
         ParamSpec::float("lambda", m.lambda, 1e-4, 100.0, "temperature"),
         ParamSpec::float(
             "sigma_speed",
