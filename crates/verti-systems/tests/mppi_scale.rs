@@ -24,7 +24,7 @@ impl RolloutModel for Recording {
         self.inner.reset(task);
     }
     fn prepare(&mut self, obs: &Observation, ctx: &PlanContext) {
-        self.seen.lock().unwrap().push(ctx.clone());
+        self.seen.lock().unwrap().push(*ctx);
         self.inner.prepare(obs, ctx);
     }
     fn rollout(&mut self, ctx: &PlanContext, controls: &ControlSamples, out: &mut Rollouts) {
@@ -55,7 +55,7 @@ fn rollouts_reach_as_far_ahead_at_every_scale() {
         m.reset(&info);
         let obs = test_observation(&world, info.start, 0.0, info.goal, &[]);
         m.plan_once(&obs);
-        let ctx = seen.lock().unwrap()[0].clone();
+        let ctx = seen.lock().unwrap()[0];
         // how far the nominal rollout runs, in look-aheads
         let ahead = ctx.nominal_speed * ctx.step * ctx.horizon as f64 / (params.lookahead * scale);
         println!(
