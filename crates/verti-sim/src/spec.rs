@@ -442,6 +442,15 @@ impl VehicleSpec {
             let w = &ax.wheel;
             pos(&f("wheel.radius"), w.radius)?;
             pos(&f("wheel.width"), w.width)?;
+            if w.width > ax.track {
+                return Err(bad(
+                    f("wheel.width"),
+                    format!(
+                        "{} is wider than the track {}: the axle's two wheels would overlap",
+                        w.width, ax.track
+                    ),
+                ));
+            }
             pos(&f("wheel.rim_radius"), w.rim_radius)?;
             if w.rim_radius >= w.radius {
                 return Err(bad(

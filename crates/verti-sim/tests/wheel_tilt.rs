@@ -168,6 +168,14 @@ fn vehicle_files_check_the_camber_gain() {
         &|s| s.axles[0].camber_gain_deg_per_m = Some(-10.0),
         "solid axle",
     );
+    // a wheel wider than its track (a tilted one of 1e308 m once overflowed the contact)
+    let mut spec = vehicles::builtin("artcar").unwrap();
+    spec.axles[1].wheel.width = 1e308;
+    let err = spec.validate("test.yaml").unwrap_err().to_string();
+    assert!(
+        err.contains("axles[1].wheel.width") && err.contains("wider than the track"),
+        "{err}"
+    );
     // absent, it is not written: files of older vehicles read and write as before
     assert!(
         !vehicles::builtin("hmmwv")
