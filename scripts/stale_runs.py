@@ -15,6 +15,8 @@ import re
 import sys
 from pathlib import Path
 
+import method_tables
+
 ROOT = Path(__file__).resolve().parent.parent
 LIST = ROOT / "benchmarks/in-progress/before-bulldozing.txt"
 TABLE_ONE = ["pid", "eh", "mppi", "rl", "mcl", "acl", "wmvct", "mppi6", "tal", "tnt"]
@@ -41,6 +43,10 @@ def page_runs(text):
     runs.update(m.rstrip("/.,)`") for m in re.findall(r"benchmarks/[\w./-]+", text))
     for set_name in re.findall(r"scripts/table_one\.py (\S+) ;", text):
         runs.update(f"benchmarks/{set_name}/{s}" for s in TABLE_ONE)
+    # the verti-100 tables of the PIETRA and VertiAdaptor pages name their runs in the script
+    for number in re.findall(r"scripts/method_tables\.py ; table: (\d+)", text):
+        entries = [method_tables.PIETRA, method_tables.VA][int(number) - 1]
+        runs.update(f"benchmarks/verti-100/{run}" for _, run in entries)
     return runs
 
 
