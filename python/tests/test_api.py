@@ -1,5 +1,6 @@
 """Worlds, the simulator and evaluation from Python."""
 
+import json
 import math
 import os
 
@@ -254,6 +255,26 @@ def test_evaluate_writes_a_resumable_results_folder(world, tmp_path):
     assert both[0] == first[0]  # resumed, not rerun
 
 
+def test_selected_tasks_of_a_named_set_build_only_their_worlds(tmp_path):
+    # tasks 11 and 12 lie on world 2 of verti-3: only it is built, and run.json records its
+    # digest alone; the trials end as they do among the whole set's worlds
+    out = tmp_path / "some"
+    some = verti.evaluate("pid", "verti-3", tasks="11-12", jobs=1, max_time=5.0, out=str(out))
+    record = json.loads((out / "run.json").read_text())
+    assert "worlds_digest" not in record
+    assert sorted(record["world_digests"]) == ["2"]
+    whole = verti.evaluate("pid", verti.load_worlds("verti-3"), tasks="11-12", jobs=1, max_time=5.0)
+
+    def strip(rs):
+        return [{k: v for k, v in r.items() if k != "wall_time"} for r in rs]
+
+    assert strip(some) == strip(whole)
+    # a resume that adds a task of world 3 builds that world too
+    verti.evaluate("pid", "verti-3", tasks="21", jobs=1, max_time=5.0, out=str(out), resume=True)
+    record = json.loads((out / "run.json").read_text())
+    assert sorted(record["world_digests"]) == ["2", "3"]
+
+
 def test_evaluate_rejects_bad_arguments(world):
     with pytest.raises(ValueError, match="unknown system `nope`"):
         verti.evaluate("nope", [world])
@@ -373,7 +394,6 @@ def test_ctrl_c_interrupts_world_generation():
 def test_ctrl_c_stops_an_evaluation_with_a_results_folder_promptly(world, tmp_path):
     """Issue 10: with out=, Ctrl-C used to wait for the whole batch (MPPI: 50 s); trials cut
     short are not recorded."""
-    import json
     import signal
     import time
 

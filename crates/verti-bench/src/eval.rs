@@ -40,6 +40,10 @@ pub struct StepLogSink<'a> {
 /// Settings of one evaluation run.
 pub struct EvalSetup<'a> {
     pub worlds: &'a [Arc<World>],
+    /// Whether `worlds` are the whole set `run.worlds` names. A run of selected tasks may load
+    /// only the worlds they are on ([`crate::run::worlds_to_load`]); its `run.json` then
+    /// records each world's digest instead of the set's.
+    pub whole_set: bool,
     pub vehicle: &'a VehicleSpec,
     pub episode: EpisodeConfig,
     pub jobs: usize,
@@ -101,6 +105,7 @@ pub fn evaluate(
     let run = crate::run::open(
         &RunSettings {
             worlds: setup.worlds,
+            whole_set: setup.whole_set,
             vehicle: setup.vehicle,
             episode: &setup.episode,
             step_log: setup.step_log.as_ref().map(|s| s.seconds),

@@ -91,7 +91,8 @@ pub fn prepare(
         ));
     }
     let id = TaskId::from_number(task).ok_or("task numbers start at 1")?;
-    // the whole set, to check by content that it is still the set the run used
+    // the whole set, to check by content that it is still the set the run used (or, for a run
+    // that recorded only its tasks' worlds, the task's world alone)
     let given = !matches!(worlds, ReplayWorlds::Recorded);
     let as_set = |worlds: Vec<World>| worlds.into_iter().map(Arc::new).collect::<Vec<_>>();
     let set: Vec<Arc<World>> = match worlds {
@@ -108,8 +109,13 @@ pub fn prepare(
             as_set(resolved.map_err(|e| format!("the worlds `{spec}`: {e}"))?)
         }
         ReplayWorlds::Recorded => as_set(
-            verti_world::sets::resolve_set(&run.worlds, run.scale, &|| {})
-                .map_err(|e| {
+            if record.some_worlds() {
+                let one = std::collections::BTreeSet::from([id.world]);
+                verti_world::sets::resolve_set_worlds(&run.worlds, run.scale, &one, &|| {})
+            } else {
+                verti_world::sets::resolve_set(&run.worlds, run.scale, &|| {})
+            }
+            .map_err(|e| {
                     format!(
                         "the run's world set `{}`: {e}; a run made on worlds held in memory is replayed by passing the same worlds (verti.replay(..., worlds=...), verti replay --worlds SET)",
                         run.worlds
@@ -118,9 +124,20 @@ pub fn prepare(
                 .worlds,
         ),
     };
-    if let Some(d) = &record.worlds_digest
-        && *d != crate::run::identity::set_digest(&set)
-    {
+    let world = set
+        .iter()
+        .find(|w| w.meta.index == id.world)
+        .cloned()
+        .ok_or_else(|| format!("`{}` has no world {}", run.worlds, id.world))?;
+    let same = match &record.worlds_digest {
+        Some(d) => *d == crate::run::identity::set_digest(&set),
+        None if record.some_worlds() => record
+            .world_digests
+            .get(&id.world)
+            .is_some_and(|d| *d == crate::run::identity::world_digest(&world)),
+        None => true,
+    };
+    if !same {
         return Err(if given {
             format!(
                 "the worlds given are not those the run in {} used (`{}`: their contents differ)",
@@ -135,11 +152,6 @@ pub fn prepare(
             )
         });
     }
-    let world = set
-        .iter()
-        .find(|w| w.meta.index == id.world)
-        .cloned()
-        .ok_or_else(|| format!("`{}` has no world {}", run.worlds, id.world))?;
     let system = registry
         .build(&run.system, &run.params)
         .map_err(|e| e.to_string())?;

@@ -53,14 +53,26 @@ pub fn note_shadowed(spec: &str) {
     }
 }
 
-/// Resolves a set for commands that take one, with a progress bar.
-/// A world set at the requested scale, and its scale: an explicit `--scale` that a saved set
-/// cannot honour is an error rather than ignored.
+/// A world set at the requested scale, with a progress bar, and its scale: an explicit
+/// `--scale` that a saved set cannot honour is an error rather than ignored. With `only`, the
+/// worlds of those indices where the set can build them alone
+/// ([`verti_world::sets::resolve_set_worlds`]).
 pub fn load_set_checked(
     spec: &str,
     scale: &ScaleArg,
+    only: Option<&std::collections::BTreeSet<u32>>,
 ) -> Result<(verti_world::sets::WorldSet, f64), WorldError> {
-    let set = load_set_with_progress(spec, scale.value())?;
+    let set = match only {
+        None => load_set_with_progress(spec, scale.value())?,
+        Some(indices) => {
+            note_shadowed(spec);
+            let pb = counter("loading", "worlds");
+            let set =
+                verti_world::sets::resolve_set_worlds(spec, scale.value(), indices, &|| pb.inc(1));
+            pb.finish_and_clear();
+            set?
+        }
+    };
     let actual = verti_world::scale::set_scale(spec, &set.worlds, scale.scale)?;
     Ok((set, actual))
 }

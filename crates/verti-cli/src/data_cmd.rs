@@ -127,7 +127,7 @@ fn generate(a: GenerateArgs) -> CmdResult {
         Kind::Expert => system_source(&a.system, &a.params)?,
     };
     verti_core::output::check_output_dir(&a.out).map_err(|p| format!("--out: {p}"))?;
-    let (set, scale) = load_set_checked(&a.worlds, &a.scale)?;
+    let (set, scale) = load_set_checked(&a.worlds, &a.scale, None)?;
     let vehicle_name = a
         .vehicle
         .clone()

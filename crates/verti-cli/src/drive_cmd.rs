@@ -60,7 +60,7 @@ pub fn drive(a: DriveArgs) -> CmdResult {
     if !(a.speed.is_finite() && a.speed > 0.0 && a.speed <= 100.0) {
         return Err(format!("--speed {}: must be in (0, 100]", a.speed).into());
     }
-    let (set, scale) = load_set_checked(&a.worlds, &a.scale)?;
+    let (set, scale) = load_set_checked(&a.worlds, &a.scale, None)?;
     let worlds: Vec<Arc<World>> = set.worlds.into_iter().map(Arc::new).collect();
     let id = verti_world::TaskId::from_number(a.task).ok_or("task numbers start at 1")?;
     let world = worlds

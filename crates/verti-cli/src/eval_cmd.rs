@@ -4,6 +4,7 @@ use crate::cli_common::{CmdResult, ScaleArg, assignment, load_set_checked, load_
 use crate::outputs::ensure_parent;
 use crate::progress::bar;
 use clap::Args;
+use std::collections::BTreeSet;
 use std::path::PathBuf;
 use std::sync::Arc;
 use verti_bench::episode::{EpisodeLog, Outcome, Rules, StartMode};
@@ -158,7 +159,30 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         .collect::<Result<Vec<_>, _>>()?;
     let perception = verti_bench::perception::PerceptionModel::load(&a.perception)
         .map_err(|e| format!("--perception: {e}"))?;
-    let (set, scale) = load_set_checked(&a.worlds, &a.scale)?;
+    // a selection of tasks needs only the worlds they are on (a shard of all tasks needs the
+    // set to list them)
+    let given = verti_bench::eval::parse_tasks(&a.tasks)?;
+    let first_needed = if a.shard.is_some() && given.is_empty() {
+        None
+    } else {
+        let mine = match &a.shard {
+            Some(shard) => shard.select(&given),
+            None => given,
+        };
+        match &a.out {
+            // a resume there may need its recorded tasks' worlds too
+            Some(dir) => systems
+                .iter()
+                .map(|s| {
+                    let out = if several { dir.join(s) } else { dir.clone() };
+                    verti_bench::run::worlds_to_load(&out, a.resume, a.force, &mine)
+                })
+                .collect::<Option<Vec<_>>>()
+                .map(|each| each.into_iter().flatten().collect()),
+            None => (!mine.is_empty()).then(|| verti_bench::run::task_worlds(&mine)),
+        }
+    };
+    let (set, scale) = load_set_checked(&a.worlds, &a.scale, first_needed.as_ref())?;
     let vehicle_name = a
         .vehicle
         .clone()
@@ -168,9 +192,12 @@ pub fn eval(a: EvalArgs) -> CmdResult {
         eprintln!("warning: {w}");
     }
     let set_name = set.name.clone();
-    let worlds: Vec<Arc<World>> = set.worlds.into_iter().map(Arc::new).collect();
-    let (selection, split) = shard_selection(&worlds, &a.tasks, a.shard)?;
-    let per_system = verti_bench::eval::select_tasks(&worlds, &selection)?.len();
+    let some_worlds = Loaded::new(set.worlds, first_needed.as_ref());
+    let (selection, split) = shard_selection(&some_worlds.worlds, &a.tasks, a.shard)?;
+    let per_system = verti_bench::eval::select_tasks(&some_worlds.worlds, &selection)?.len();
+    // the whole set, loaded only when a system's run needs it (a resume of a run recorded
+    // over the whole set)
+    let mut whole: Option<Loaded> = None;
     // one progress display for the whole sequence
     let pb = bar((per_system * systems.len()) as u64, &systems.join(", "));
     for system in &ready {
@@ -180,10 +207,21 @@ pub fn eval(a: EvalArgs) -> CmdResult {
             (None, _) => PathBuf::from("results").join(format!("{}-{set_name}", system.name())),
         };
         pb.set_message(system.name().to_string());
+        let needed = verti_bench::run::worlds_to_load(&out, a.resume, a.force, &selection);
+        let loaded = if some_worlds.holds(needed.as_ref()) {
+            &some_worlds
+        } else {
+            if whole.is_none() {
+                let (set, _) = load_set_checked(&a.worlds, &a.scale, None)?;
+                whole = Some(Loaded::new(set.worlds, None));
+            }
+            whole.as_ref().expect("loaded above")
+        };
         let shared = Shared {
             selection: &selection,
             perception: (!perception.is_none()).then(|| Arc::new(perception.clone())),
-            worlds: &worlds,
+            worlds: &loaded.worlds,
+            whole_set: loaded.whole,
             vehicle: &vehicle,
             scale,
             set_name: &set_name,
@@ -241,11 +279,54 @@ fn shard_selection(
     Ok((mine, Some(split)))
 }
 
+/// The worlds a run loaded: the whole set, or only the worlds of its tasks.
+struct Loaded {
+    worlds: Vec<Arc<World>>,
+    whole: bool,
+}
+
+impl Loaded {
+    /// `worlds` as loaded for `needed` (`None`: the whole set). A loader may return more than
+    /// was asked (a saved set is read whole): those are kept only when it lacks a world asked
+    /// for, so that the task check names the set's real range.
+    fn new(worlds: Vec<World>, needed: Option<&BTreeSet<u32>>) -> Self {
+        let has_all =
+            |n: &BTreeSet<u32>| n.iter().all(|i| worlds.iter().any(|w| w.meta.index == *i));
+        match needed {
+            Some(n) if has_all(n) => Loaded {
+                worlds: worlds
+                    .into_iter()
+                    .filter(|w| n.contains(&w.meta.index))
+                    .map(Arc::new)
+                    .collect(),
+                whole: false,
+            },
+            _ => Loaded {
+                worlds: worlds.into_iter().map(Arc::new).collect(),
+                whole: true,
+            },
+        }
+    }
+
+    /// Whether these worlds serve a run that needs `needed`.
+    fn holds(&self, needed: Option<&BTreeSet<u32>>) -> bool {
+        match needed {
+            None => self.whole,
+            Some(n) => {
+                self.whole
+                    || n.iter()
+                        .all(|i| self.worlds.iter().any(|w| w.meta.index == *i))
+            }
+        }
+    }
+}
+
 /// What every system of one `verti eval` shares.
 struct Shared<'a> {
     selection: &'a [u32],
     perception: Option<Arc<verti_bench::perception::PerceptionModel>>,
     worlds: &'a [Arc<World>],
+    whole_set: bool,
     vehicle: &'a verti_sim::VehicleSpec,
     scale: f64,
     set_name: &'a str,
@@ -284,6 +365,7 @@ fn eval_system(
     };
     let setup = EvalSetup {
         worlds,
+        whole_set: sh.whole_set,
         vehicle,
         episode,
         jobs,

@@ -202,6 +202,7 @@ fn navigate(a: &NavigateArgs) -> Result<(), String> {
         };
         let setup = EvalSetup {
             worlds: &worlds,
+            whole_set: true,
             vehicle: &vehicle,
             episode: EpisodeConfig {
                 max_time: a.max_time,

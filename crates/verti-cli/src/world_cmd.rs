@@ -295,7 +295,7 @@ fn render(a: RenderArgs) -> CmdResult {
 }
 
 fn stats(a: StatsArgs) -> CmdResult {
-    let (set, _) = load_set_checked(&a.set, &a.scale)?;
+    let (set, _) = load_set_checked(&a.set, &a.scale, None)?;
     let stats = verti_world::stats::set_stats(&set.worlds);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&stats)?);

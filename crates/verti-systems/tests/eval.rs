@@ -38,6 +38,7 @@ fn setup<'a>(
 ) -> EvalSetup<'a> {
     EvalSetup {
         worlds,
+        whole_set: true,
         vehicle,
         episode: EpisodeConfig {
             max_time: 30.0,

@@ -115,6 +115,7 @@ fn results_do_not_depend_on_the_number_of_jobs() {
         let _ = std::fs::remove_dir_all(&out);
         let setup = EvalSetup {
             worlds: &worlds,
+            whole_set: true,
             vehicle: &hmmwv,
             episode: episode(),
             jobs,

@@ -147,6 +147,7 @@ fn setup<'a>(
 ) -> EvalSetup<'a> {
     EvalSetup {
         worlds,
+        whole_set: true,
         vehicle,
         episode: EpisodeConfig {
             max_time: 5.0,

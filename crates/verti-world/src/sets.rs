@@ -148,6 +148,80 @@ pub fn resolve_set(spec: &str, scale: f64, progress: &(dyn Fn() + Sync)) -> Resu
     )))
 }
 
+/// The worlds of set `spec` with the given indices, for a run of selected tasks (a task's world
+/// is its number's: see [`crate::TaskId`]): a built-in set generates only those worlds and a
+/// Verti-Bench folder imports only those, each exactly as the whole set would hold it. A saved
+/// set or world is read whole, as is a set lacking one of the indices (so that the run's task
+/// check names the set's real range). The worlds come in the set's order.
+pub fn resolve_set_worlds(
+    spec: &str,
+    scale: f64,
+    indices: &std::collections::BTreeSet<u32>,
+    progress: &(dyn Fn() + Sync),
+) -> Result<WorldSet> {
+    let path = Path::new(spec);
+    let saved = present(&path.join(SET_MANIFEST))
+        || present(&path.join(MANIFEST))
+        || (path.is_file() && path.extension().is_some_and(|e| e == "yaml"));
+    if saved || indices.is_empty() {
+        return resolve_set(spec, scale, progress);
+    }
+    if path.is_dir() && has_vb_configs(path) {
+        let files = scan_vb_dir(path)?;
+        let chosen: Vec<_> = files
+            .iter()
+            .filter(|f| indices.contains(&f.index))
+            .collect();
+        if chosen.len() != indices.len() {
+            return resolve_set(spec, scale, progress);
+        }
+        let opts = ImportOptions {
+            scale,
+            ..Default::default()
+        };
+        let worlds = chosen
+            .par_iter()
+            .map(|f| {
+                let w = import_vb(&f.config, &f.heightmap, f.labels.as_deref(), &opts);
+                progress();
+                w
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("verti-bench")
+            .to_string();
+        return Ok(WorldSet {
+            name: format!("vb-{name}"),
+            worlds,
+        });
+    }
+    if let Some(config) = builtin_config(spec, scale) {
+        config.validate()?;
+        if indices.iter().any(|&i| i == 0 || i > config.count) {
+            return resolve_set(spec, scale, progress);
+        }
+        let comp = crate::generate::composition(&config);
+        let source = crate::generate::elevation::ProceduralRock::default();
+        let wanted: Vec<u32> = indices.iter().copied().collect();
+        let worlds = wanted
+            .par_iter()
+            .map(|&i| {
+                let (level, ty, density) = comp[i as usize - 1];
+                let w = crate::generate::generate_world(&config, i, level, ty, density, &source);
+                progress();
+                w
+            })
+            .collect::<Result<Vec<_>>>()?;
+        return Ok(WorldSet {
+            name: set_name(&config),
+            worlds,
+        });
+    }
+    resolve_set(spec, scale, progress)
+}
+
 /// Resolves a single world: a world directory or `SET:INDEX` (1-based index).
 pub fn resolve_world(spec: &str, scale: f64) -> Result<World> {
     let path = Path::new(spec);
@@ -218,6 +292,22 @@ mod tests {
         let c = builtin_config("verti-20-s7", 0.1).unwrap();
         assert_eq!((c.count, c.seed, c.scale), (20, 7, 0.1));
         assert!(builtin_config("vertix", 1.0).is_none());
+    }
+
+    #[test]
+    fn selected_worlds_equal_the_set_members() {
+        let set = resolve_set("verti-6", 1.0, &|| {}).unwrap();
+        let pick = std::collections::BTreeSet::from([2, 5]);
+        let some = resolve_set_worlds("verti-6", 1.0, &pick, &|| {}).unwrap();
+        assert_eq!(some.name, set.name);
+        assert_eq!(
+            some.worlds,
+            vec![set.worlds[1].clone(), set.worlds[4].clone()]
+        );
+        // an index the set lacks: the whole set, for the caller's range check to report
+        let beyond = std::collections::BTreeSet::from([2, 7]);
+        let all = resolve_set_worlds("verti-6", 1.0, &beyond, &|| {}).unwrap();
+        assert_eq!(all.worlds.len(), 6);
     }
 
     #[test]

@@ -357,3 +357,27 @@ fn labels_are_checked_at_every_pixel_and_levels_against_max_height() {
     );
     std::fs::remove_dir_all(&tmp).ok();
 }
+
+#[test]
+fn a_selection_of_original_worlds_imports_only_those_and_alike() {
+    let Some(dir) = vb_dir() else { return };
+    let spec = dir.to_str().unwrap();
+    let files = scan_vb_dir(&dir).unwrap();
+    // two worlds of the folder, by their indices (which need not be 1..=80)
+    let pick: std::collections::BTreeSet<u32> = [files[3].index, files[41].index].into();
+    let count = std::sync::atomic::AtomicUsize::new(0);
+    let some = verti_world::sets::resolve_set_worlds(spec, 1.0, &pick, &|| {
+        count.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    })
+    .unwrap();
+    assert_eq!(count.into_inner(), 2, "only the two worlds are imported");
+    let whole = verti_world::sets::resolve_set(spec, 1.0, &|| {}).unwrap();
+    assert_eq!(some.name, whole.name);
+    let members: Vec<_> = whole
+        .worlds
+        .iter()
+        .filter(|w| pick.contains(&w.meta.index))
+        .cloned()
+        .collect();
+    assert_eq!(some.worlds, members);
+}

@@ -21,6 +21,8 @@ fn settings(r: &RunRecord) -> BTreeMap<String, String> {
     put("system", run.system.clone());
     put(
         "worlds",
+        // a run of selected tasks recorded only its worlds' digests: it goes by the set's
+        // name (`separate_runs` tells apart two that disagree on a world)
         match &r.worlds_digest {
             Some(d) => format!("{}#{}", run.worlds, &d[..8.min(d.len())]),
             None => run.worlds.clone(),
@@ -86,7 +88,7 @@ pub(super) fn separate_runs(
     }
     // one identity per file: its settings, or nothing for a file without run.json (its trials
     // are then told apart by their system and vehicle alone, as they were before run.json)
-    let identity: Vec<BTreeMap<String, String>> = files
+    let mut identity: Vec<BTreeMap<String, String>> = files
         .iter()
         .zip(results.iter())
         .map(|(f, rs)| match &f.run {
@@ -97,6 +99,32 @@ pub(super) fn separate_runs(
             )]),
         })
         .collect();
+    // runs of selected tasks with the same settings are one run unless they disagree on the
+    // contents of a world both ran on: then each is labelled by its worlds' digest
+    for i in 0..files.len() {
+        for j in 0..i {
+            let (Some(a), Some(b)) = (&files[i].run, &files[j].run) else {
+                continue;
+            };
+            let clash = a.some_worlds()
+                && b.some_worlds()
+                && identity[i] == identity[j]
+                && a.world_digests
+                    .iter()
+                    .any(|(w, d)| b.world_digests.get(w).is_some_and(|e| e != d));
+            if clash {
+                for (k, r) in [(i, a), (j, b)] {
+                    let hex = verti_core::digest::Digest::new()
+                        .debug(&r.world_digests)
+                        .hex();
+                    identity[k].insert(
+                        "worlds".into(),
+                        format!("{}#{}", r.run.worlds, &hex[..8.min(hex.len())]),
+                    );
+                }
+            }
+        }
+    }
     // files of one identity merge, but may not share a task
     type Key<'a> = (Option<&'a BTreeMap<String, String>>, &'a str, &'a str, u32);
     let mut owner: HashMap<Key, usize> = HashMap::new();

@@ -39,6 +39,7 @@ pub(crate) fn open(setup: &RunSettings, selection: &[u32]) -> Result<OpenRun, Ev
     let mut record = RunRecord::new(
         setup.run,
         setup.worlds,
+        setup.whole_set,
         setup.vehicle,
         setup.episode.start,
         setup.step_log,

@@ -10,6 +10,7 @@
 use super::error::EvalError;
 use crate::episode::StartMode;
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 use verti_core::digest::Digest;
@@ -48,6 +49,18 @@ pub fn set_digest(worlds: &[Arc<World>]) -> String {
         d.u64(*index as u64).str(digest);
     }
     d.hex()
+}
+
+/// [`world_digest`] of each world, by index: what a run of selected tasks records when it
+/// loaded only the worlds they are on.
+pub fn world_digests(worlds: &[Arc<World>]) -> BTreeMap<u32, String> {
+    use rayon::prelude::*;
+    worlds
+        .par_iter()
+        .map(|w| (w.meta.index, world_digest(w)))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect()
 }
 
 /// Digest of a vehicle spec (every field of it, the name included).
@@ -165,9 +178,15 @@ pub struct RunInfo {
 pub struct RunRecord {
     #[serde(flatten)]
     pub run: RunInfo,
-    /// [`set_digest`] of the worlds run (absent in runs recorded before digests).
+    /// [`set_digest`] of the whole world set (absent in runs recorded before digests, and in
+    /// runs that loaded only their tasks' worlds: those record `world_digests`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub worlds_digest: Option<String>,
+    /// [`world_digest`] of each world the run's tasks are on, by index, for a run of selected
+    /// tasks that loaded only those worlds (`verti eval --tasks 1-5` builds one world, not
+    /// the set's hundred). Runs compare on the worlds both hold.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub world_digests: BTreeMap<u32, String>,
     /// [`vehicle_digest`] of the vehicle driven (absent in runs recorded before digests).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub vehicle_digest: Option<String>,
@@ -202,17 +221,26 @@ pub struct RunRecord {
 }
 
 impl RunRecord {
-    /// The record of `run` over `worlds` with `vehicle` (digests computed here).
+    /// The record of `run` over `worlds` with `vehicle` (digests computed here): `whole_set`
+    /// when `worlds` are the whole set `run.worlds` names, else only some of its worlds (then
+    /// each world's digest is recorded instead of the set's).
     pub fn new(
         run: &RunInfo,
         worlds: &[Arc<World>],
+        whole_set: bool,
         vehicle: &VehicleSpec,
         start: StartMode,
         step_log: Option<f64>,
     ) -> Self {
+        let (worlds_digest, world_digests) = if whole_set {
+            (Some(set_digest(worlds)), BTreeMap::new())
+        } else {
+            (None, self::world_digests(worlds))
+        };
         RunRecord {
             run: run.clone(),
-            worlds_digest: Some(set_digest(worlds)),
+            worlds_digest,
+            world_digests,
             vehicle_digest: Some(vehicle_digest(vehicle)),
             vehicle_spec: Some(vehicle.clone()),
             start,
@@ -241,7 +269,14 @@ impl RunRecord {
     /// Whether this record predates content digests (then worlds and vehicle can only be
     /// compared by name).
     pub fn by_name_only(&self) -> bool {
-        self.worlds_digest.is_none() || self.vehicle_digest.is_none()
+        (self.worlds_digest.is_none() && self.world_digests.is_empty())
+            || self.vehicle_digest.is_none()
+    }
+
+    /// Whether the run recorded only its tasks' worlds ([`RunRecord::world_digests`]), not the
+    /// whole set's digest.
+    pub fn some_worlds(&self) -> bool {
+        self.worlds_digest.is_none() && !self.world_digests.is_empty()
     }
 
     /// The settings in which `recorded` (read from `run.json`) differs from this run, each as
@@ -261,6 +296,38 @@ impl RunRecord {
                 short(y)
             )),
             (Some(_), Some(_)) => {}
+            _ if recorded.some_worlds() && self.some_worlds() => {
+                let differing: Vec<String> = recorded
+                    .world_digests
+                    .iter()
+                    .filter(|(i, d)| self.world_digests.get(i).is_some_and(|e| e != *d))
+                    .map(|(i, _)| i.to_string())
+                    .collect();
+                if !differing.is_empty() {
+                    out.push(format!(
+                        "world set: its contents differ (world(s) {} of `{}` recorded, `{}` now)",
+                        differing.join(", "),
+                        a.worlds,
+                        b.worlds
+                    ));
+                }
+            }
+            _ if recorded.some_worlds() || self.some_worlds() => {
+                let kind = |r: &RunRecord| {
+                    if r.some_worlds() {
+                        "only its tasks' worlds"
+                    } else {
+                        "the whole set"
+                    }
+                };
+                out.push(format!(
+                    "world set: `{}` recorded by {}, `{}` now by {}, so their contents cannot be compared",
+                    a.worlds,
+                    kind(recorded),
+                    b.worlds,
+                    kind(self)
+                ));
+            }
             _ => differ(&mut out, "world set", a.worlds.clone(), b.worlds.clone()),
         }
         match (&recorded.vehicle_digest, &self.vehicle_digest) {

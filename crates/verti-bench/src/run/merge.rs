@@ -57,8 +57,11 @@ pub fn join(shards: &[PathBuf]) -> Result<Joined, EvalError> {
     let mut duplicates = 0;
     let mut covers_all = false;
     let mut given_shards = BTreeSet::new();
+    // shards of selected tasks record the digests of their own worlds; the join holds them all
+    let mut world_digests = BTreeMap::new();
     for dir in shards {
         let record = RunRecord::read(&dir.join(RUN_FILE))?;
+        world_digests.extend(record.world_digests.clone());
         match &first {
             None => first = Some((record.clone(), dir.clone())),
             Some((base, base_dir)) => {
@@ -128,6 +131,9 @@ pub fn join(shards: &[PathBuf]) -> Result<Joined, EvalError> {
         }
     }
     let (mut record, _) = first.expect("at least one shard");
+    if record.some_worlds() {
+        record.world_digests = world_digests;
+    }
     let unfinished = selected
         .iter()
         .filter(|(n, _)| !by_task.contains_key(n))

@@ -32,7 +32,7 @@ pub(crate) use dir::open;
 pub use error::EvalError;
 pub(crate) use error::io;
 pub use results::{read_results, result_line};
-pub use tasks::{format_tasks, parse_tasks, select_tasks};
+pub use tasks::{format_tasks, parse_tasks, select_tasks, task_worlds, worlds_to_load};
 
 use crate::episode::EpisodeConfig;
 use identity::{InputFile, RunInfo, SplitRecord};
@@ -53,6 +53,8 @@ pub const LOCK_FILE: &str = ".lock";
 /// because both read it.
 pub(crate) struct RunSettings<'a> {
     pub worlds: &'a [Arc<World>],
+    /// `worlds` are the whole set (else only the worlds of the run's tasks).
+    pub whole_set: bool,
     pub vehicle: &'a VehicleSpec,
     /// The episode settings (the start mode and perception noise are recorded).
     pub episode: &'a EpisodeConfig,

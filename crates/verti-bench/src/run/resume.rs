@@ -56,7 +56,15 @@ pub(super) fn resume(
         Some(inputs) => inputs(&select_tasks(setup.worlds, selection)?)?,
         None => Vec::new(),
     };
-    let differences = record.differences(&before);
+    // a run of selected tasks records each world's digest; continued over the whole set (or
+    // over more worlds) it is compared world by world, and keeps the digests of the worlds it
+    // recorded before
+    let mut now = record.clone();
+    if before.some_worlds() && !record.some_worlds() {
+        now.worlds_digest = None;
+        now.world_digests = super::identity::world_digests(setup.worlds);
+    }
+    let differences = now.differences(&before);
     if !differences.is_empty() {
         return Err(EvalError::Argument(format!(
             "cannot resume {}: {} records a different run ({}); start a new run with another --out, or pass --force to discard it",
@@ -64,6 +72,11 @@ pub(super) fn resume(
             run_path.display(),
             differences.join("; ")
         )));
+    }
+    if record.some_worlds() {
+        for (index, digest) in &before.world_digests {
+            record.world_digests.entry(*index).or_insert(digest.clone());
+        }
     }
     if before.by_name_only()
         && let Some(warn) = setup.warn

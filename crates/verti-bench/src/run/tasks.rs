@@ -76,6 +76,47 @@ pub fn parse_tasks(spec: &str) -> Result<Vec<u32>, EvalError> {
     Ok(out.into_iter().collect())
 }
 
+/// The indices of the worlds a run of `selection` (task numbers; empty for all) with its
+/// directory at `out` needs, or `None` for the whole set. A resume (`resume` without `force`,
+/// results in `out`) continues the recorded selection too ([`super::resume`]: it runs the
+/// recorded selection when given none), so its tasks' worlds are added; a run recorded over
+/// the whole set or all its tasks (or whose `run.json` cannot be read: the resume reports
+/// that) needs the whole set again, to be compared with it by content.
+pub fn worlds_to_load(
+    out: &std::path::Path,
+    resume: bool,
+    force: bool,
+    selection: &[u32],
+) -> Option<BTreeSet<u32>> {
+    let mut tasks: BTreeSet<u32> = selection.iter().copied().collect();
+    let mut worlds = BTreeSet::new();
+    if resume && !force && out.join(super::RESULTS_FILE).exists() {
+        let record = super::identity::RunRecord::read(&out.join(super::RUN_FILE)).ok()?;
+        if !record.some_worlds() {
+            return None;
+        }
+        let recorded = parse_tasks(record.tasks.as_deref()?).ok()?;
+        if recorded.is_empty() {
+            return None;
+        }
+        tasks.extend(recorded);
+        worlds.extend(record.world_digests.keys().copied());
+    } else if selection.is_empty() {
+        return None;
+    }
+    worlds.extend(task_worlds(&tasks.into_iter().collect::<Vec<_>>()));
+    Some(worlds)
+}
+
+/// The indices of the worlds tasks `tasks` are on (`TaskId::from_number`'s numbering, which
+/// every set shares).
+pub fn task_worlds(tasks: &[u32]) -> BTreeSet<u32> {
+    tasks
+        .iter()
+        .filter_map(|&n| TaskId::from_number(n).map(|t| t.world))
+        .collect()
+}
+
 /// Resolves the selected task numbers against a set: all tasks of the set when `selection` is
 /// empty; otherwise each number must name a task of a world in the set.
 pub fn select_tasks(

@@ -244,6 +244,7 @@ pub(super) fn evaluate(
     let Prepared {
         spec,
         worlds,
+        whole_set,
         worlds_name,
         selected,
         episode,
@@ -317,6 +318,7 @@ pub(super) fn evaluate(
     if !numbers.is_empty() {
         let setup = EvalSetup {
             worlds: &worlds,
+            whole_set,
             vehicle: &spec,
             episode: episode.clone(),
             jobs,
@@ -384,6 +386,8 @@ pub(super) struct EvalArgs<'a, 'py> {
 struct Prepared {
     spec: VehicleSpec,
     worlds: Vec<Arc<World>>,
+    /// Whether `worlds` are the whole set (else only the selected tasks' worlds).
+    whole_set: bool,
     worlds_name: String,
     selected: Vec<(usize, u32)>,
     episode: EpisodeConfig,
@@ -399,10 +403,22 @@ pub(super) fn perception_arg(
 }
 
 fn prepare(py: Python<'_>, a: &EvalArgs<'_, '_>) -> PyResult<Prepared> {
-    let (worlds, worlds_name) = match a.worlds {
-        Some(w) if !w.is_none() => worlds_arg(py, w, a.scale)?,
-        _ => worlds_arg(py, PyString::new(py, "verti-100").as_any(), a.scale)?,
+    // a selection of tasks needs only the worlds they are on, and a resume those of the
+    // recorded run too (`worlds_to_load`)
+    let selection = tasks_arg(a.tasks)?;
+    let only = match &a.out {
+        Some(out) => verti_bench::run::worlds_to_load(out, a.resume, a.force, &selection),
+        None => (!selection.is_empty()).then(|| verti_bench::run::task_worlds(&selection)),
     };
+    let default = PyString::new(py, "verti-100");
+    let arg = match a.worlds {
+        Some(w) if !w.is_none() => w,
+        _ => default.as_any(),
+    };
+    let (worlds, worlds_name, whole_set) = some_worlds_arg(py, arg, a.scale, only.as_ref())?;
+    if worlds.is_empty() {
+        return Err(value_err(format!("`{worlds_name}` holds no worlds")));
+    }
     // as on the command line: the worlds' scale picks the default vehicle, and a vehicle
     // built for another scale runs with a warning
     let scale = worlds[0].meta.scale;
@@ -415,7 +431,6 @@ fn prepare(py: Python<'_>, a: &EvalArgs<'_, '_>) -> PyResult<Prepared> {
         let text = std::ffi::CString::new(m.replace('\0', " ")).expect("no NUL left");
         PyErr::warn(py, &category, &text, 1)?;
     }
-    let selection = tasks_arg(a.tasks)?;
     let start = verti_bench::StartMode::from_name(a.start).ok_or_else(|| {
         value_err(format!(
             "unknown start {:?}: use 'settled' or 'drop'",
@@ -435,6 +450,7 @@ fn prepare(py: Python<'_>, a: &EvalArgs<'_, '_>) -> PyResult<Prepared> {
     Ok(Prepared {
         spec,
         worlds,
+        whole_set,
         worlds_name,
         selected,
         episode,
@@ -463,6 +479,7 @@ fn evaluate_object(
     let Prepared {
         spec,
         worlds,
+        whole_set,
         worlds_name,
         selected,
         episode,
@@ -518,6 +535,7 @@ fn evaluate_object(
     };
     let setup = EvalSetup {
         worlds: &worlds,
+        whole_set,
         vehicle: &spec,
         episode,
         jobs: 1,

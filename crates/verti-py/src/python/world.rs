@@ -535,6 +535,50 @@ pub(super) fn load_worlds(
         .collect())
 }
 
+/// [`worlds_arg`] for a run of selected tasks: a set given by name builds only the worlds
+/// `only` names where it can ([`verti_world::sets::resolve_set_worlds`]); the flag says
+/// whether the worlds returned are the whole set the argument names.
+pub(super) fn some_worlds_arg(
+    py: Python<'_>,
+    arg: &Bound<'_, PyAny>,
+    scale: Option<f64>,
+    only: Option<&std::collections::BTreeSet<u32>>,
+) -> PyResult<(Vec<Arc<World>>, String, bool)> {
+    let set_name = arg.cast::<PyString>().ok().and_then(|s| {
+        let spec: String = s.extract().ok()?;
+        let one_world = spec
+            .rsplit_once(':')
+            .is_some_and(|(_, i)| i.parse::<u32>().is_ok());
+        (!one_world).then_some(spec)
+    });
+    let (Some(spec), Some(only)) = (set_name, only) else {
+        let (worlds, name) = worlds_arg(py, arg, scale)?;
+        return Ok((worlds, name, true));
+    };
+    if let Some(s) = scale {
+        verti_world::scale::check_scale(s).map_err(world_err)?;
+    }
+    let cancel = AtomicBool::new(false);
+    let set = interruptible(py, &cancel, || {
+        let set = verti_world::sets::resolve_set_worlds(&spec, scale.unwrap_or(1.0), only, &|| {})?;
+        verti_world::scale::set_scale(&spec, &set.worlds, scale)?;
+        Ok(set)
+    })?
+    .map_err(world_err)?;
+    // a saved set is read whole: keep only the worlds asked for, unless one is missing (then
+    // the task check names the set's real range)
+    let has_all = only
+        .iter()
+        .all(|i| set.worlds.iter().any(|w| w.meta.index == *i));
+    let worlds: Vec<Arc<World>> = set
+        .worlds
+        .into_iter()
+        .filter(|w| !has_all || only.contains(&w.meta.index))
+        .map(Arc::new)
+        .collect();
+    Ok((worlds, spec, !has_all))
+}
+
 /// Worlds from a Python argument: a World, a list of Worlds or a name (see `load_worlds`;
 /// `SET:INDEX` names one world).
 /// `scale` (default 1) applies to generated and imported worlds; worlds already built keep
