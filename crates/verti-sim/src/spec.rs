@@ -516,12 +516,13 @@ impl VehicleSpec {
                     ));
                 }
                 // a swing arm shorter than the wheel's radius is no suspension
-                if g.to_radians().abs() * ax.wheel.radius > 1.0 {
+                let per_m = g.to_radians().abs();
+                if per_m * ax.wheel.radius > 1.0 {
                     return Err(bad(
                         f("camber_gain_deg_per_m"),
                         format!(
                             "{g}: a swing arm of {:.3} m, shorter than the wheel's radius {}",
-                            1.0 / g.to_radians().abs(),
+                            1.0 / per_m,
                             ax.wheel.radius
                         ),
                     ));

@@ -64,11 +64,6 @@ pub(crate) fn seat(world: &World, spec: &VehicleSpec, start: StartPose) -> Resul
         * GRAVITY;
     let load = weight / spec.wheel_count() as f64;
     let deflection = load / spec.tyre.radial_stiffness;
-    // a track's road wheels bear on soil through the belt's plates (`WheelModel::belt_plate`)
-    let plate_length = |k: usize| {
-        let (ahead, behind) = spec.belt_plate(k);
-        ahead + behind
-    };
     let mut z = f64::NEG_INFINITY;
     for (lx, ly, _, k) in &rows {
         let ax = &spec.axles[*k];
@@ -82,7 +77,10 @@ pub(crate) fn seat(world: &World, spec: &VehicleSpec, start: StartPose) -> Resul
         // that first bounce (deep enough to high-centre a HMMWV in snow).
         let sunk = match world.patches.at(hx, hy).surface {
             Surface::Deformable { soil } if world.terrain.contains(hx, hy) => {
-                match plate_length(*k) {
+                // a track's road wheels bear on soil through the belt's plates
+                // (`WheelModel::belt_plate`)
+                let (ahead, behind) = spec.belt_plate(*k);
+                match ahead + behind {
                     l if l > 0.0 => plate_sinkage(load * nz, ax.wheel.width, l, &soil),
                     _ => static_sinkage(load * nz, ax.wheel.width, ax.wheel.radius, &soil),
                 }
