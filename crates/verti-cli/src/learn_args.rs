@@ -52,8 +52,9 @@ pub struct VaArgs {
     /// Benchmark: test data (random exploration on unseen worlds, several trials per world).
     #[arg(long, default_value = "data/va-test-s3")]
     pub test: PathBuf,
-    /// Benchmark: LABEL=CARD pairs, comma-separated (default: va, node, maml, mlp from
-    /// crates/verti-va/models/ and the three ablations from results/va-bench/models/).
+    /// Benchmark: LABEL=CARD pairs, comma-separated (default: va, node, maml, mlp and va-small
+    /// from crates/verti-va/models/, and va-retrained with the three ablations from
+    /// results/va-bench/models/).
     #[arg(long, value_delimiter = ',')]
     pub models: Vec<String>,
     /// Benchmark: adaptation trajectories per world (the rest are scored).

@@ -23,11 +23,12 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// The paper's order of its rows; other labels follow alphabetically.
-const ORDER: [&str; 12] = [
+const ORDER: [&str; 13] = [
     "va",
     "node",
     "maml",
     "mlp",
+    "va-retrained",
     "va-no-semantics",
     "va-no-elevation",
     "va-no-both",
