@@ -78,10 +78,10 @@ pub fn parse_tasks(spec: &str) -> Result<Vec<u32>, EvalError> {
 
 /// The indices of the worlds a run of `selection` (task numbers; empty for all) with its
 /// directory at `out` needs, or `None` for the whole set. A resume (`resume` without `force`,
-/// results in `out`) continues the recorded selection too ([`super::resume`]: it runs the
-/// recorded selection when given none), so its tasks' worlds are added; a run recorded over
-/// the whole set or all its tasks (or whose `run.json` cannot be read: the resume reports
-/// that) needs the whole set again, to be compared with it by content.
+/// results in `out`) continues the recorded selection too (and runs it alone when given
+/// none), so its tasks' worlds are added; a run recorded over the whole set or all its tasks
+/// (or whose `run.json` cannot be read: the resume reports that) needs the whole set again,
+/// to be compared with it by content.
 pub fn worlds_to_load(
     out: &std::path::Path,
     resume: bool,
