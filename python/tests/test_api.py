@@ -413,3 +413,13 @@ def test_ctrl_c_stops_an_evaluation_with_a_results_folder_promptly(world, tmp_pa
     assert time.perf_counter() - t0 < 5.0
     for line in (out / "results.jsonl").read_text().splitlines():
         assert json.loads(line)["outcome"] != "error"
+
+
+def test_help_documents_every_argument_of_evaluate_and_load_worlds():
+    import inspect
+
+    doc = verti.evaluate.__doc__
+    for name in inspect.signature(verti.evaluate).parameters:
+        assert f"- {name}:" in doc, name
+    assert "pysystem" not in doc  # a private module is no help
+    assert str(inspect.signature(verti.load_worlds)) == "(spec='verti-100', scale=None)"

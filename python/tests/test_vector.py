@@ -52,6 +52,13 @@ def test_next_step_autoreset(world):
     assert [verti.envs.outcome_name(c) for c in info["outcome"]] == ["timeout", "timeout"]
     assert info["_outcome"].all() and (info["path_length"] > 0).all()
     assert vec.env_info(0)["metrics"]["outcome"] == "timeout"
+    # codes, not names: comparing them with a name cannot silently count nothing
+    assert info["outcome"].dtype == np.int8
+    assert (info["outcome"] == verti.OUTCOMES.index("timeout")).all()
+    with pytest.raises(TypeError, match=r"verti.OUTCOMES.index\('success'\)"):
+        _ = info["outcome"] == "success"
+    with pytest.raises(TypeError, match="holds codes, not names"):
+        _ = info["outcome"] != "timeout"
     # the next step resets: reward 0, not done, time back to 0
     obs, rewards, term, trunc, info = vec.step(np.ones((2, 2)))
     assert (rewards == 0).all() and not term.any() and not trunc.any()

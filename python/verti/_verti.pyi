@@ -516,9 +516,37 @@ def evaluate(
 ) -> list[dict[str, Any]]:
     """Runs ``system`` on the selected tasks, ``jobs`` trials at a time, and returns one dict per
     trial (the fields of ``results.jsonl``), sorted by task. With ``out``, results are also
-    written there, resumable like ``verti eval``. Ctrl-C stops it. ``system`` is a built-in
-    system's name (default ``pid``) or a Python object with ``reset(task)`` and ``act(obs)``,
-    which runs one trial at a time through the same trial code."""
+    written there, resumable like ``verti eval``. Ctrl-C stops it.
+
+    Arguments:
+
+    - system: a built-in system's name (default ``"pid"``; ``verti.systems()`` lists them), or
+      a Python object with ``reset(task)`` and ``act(obs)``, run one trial at a time through
+      the same trial code. ``act`` returns (target speed m/s, steering in [-1, 1]), or with
+      ``action_mode = "low"`` (throttle, brake, steering). Optional attributes: ``name``,
+      ``control_rate`` (Hz), ``action_mode``, ``state_features``, ``lookahead``,
+      ``elevation``, ``semantic``, ``occupancy`` (the observation the object asks for).
+    - worlds: a set by name (``"verti-100"``, the default; a saved set, a world directory or a
+      folder of Verti-Bench worlds), ``"SET:INDEX"`` for one world, a World or a list of
+      Worlds. A set by name builds only the worlds of the selected tasks.
+    - tasks: task numbers, as ``"1-10,15"``, an int, a sequence or an array of ints; None for
+      all.
+    - jobs: trials run at once (default: one per core; a Python system runs one at a time).
+    - vehicle: a built-in vehicle's name or a vehicle YAML file (default: the vehicle for the
+      worlds' scale).
+    - params: a built-in system's parameters, ``{name: value}`` or (name, value) pairs, each
+      checked against its declared type and range.
+    - rules: ``"paper"`` (default) or ``"verti-bench"`` (the reference code's rules).
+    - max_time: seconds per trial before a timeout (default 60).
+    - seed: the seed of every random draw (default 0): same seed, same results.
+    - scale: the scale to build named worlds at (default 1).
+    - start: ``"settled"`` (default) or ``"drop"`` (Verti-Bench's spawn above the ground).
+    - out: a folder for ``results.jsonl`` and ``run.json``, created if missing (its parent must
+      exist).
+    - resume: continue the run in ``out``, skipping finished tasks.
+    - force: discard the run in ``out`` and start over.
+    - perception: ``"none"`` (default), ``"low"``, ``"medium"``, ``"high"`` or a perception
+      YAML file: noise on what the system observes."""
 
 def systems() -> list[dict[str, Any]]:
     """The systems that ``evaluate`` knows, with their parameters (name, type, default, min and

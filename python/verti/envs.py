@@ -405,13 +405,17 @@ class NavigateVectorEnv(VectorEnv):
         else:
             core_seed = seed
         self._sampler_seeded = True
-        return self._core.reset(seed=core_seed)
+        obs, info = self._core.reset(seed=core_seed)
+        if "outcome" in info:
+            info["outcome"] = np.asarray(info["outcome"]).view(OutcomeCodes)
+        return obs, info
 
     def step(self, actions):
         a = np.asarray(actions, dtype=np.float64)
         if a.ndim == 1:
             a = a.reshape(self.num_envs, -1) if a.size % self.num_envs == 0 else a.reshape(1, -1)
         obs, rewards, terminated, truncated, info = self._core.step(a)
+        info["outcome"] = np.asarray(info["outcome"]).view(OutcomeCodes)
         if self._reward_fn is not None:
             # slow path: the callable sees one environment at a time
             rewards = np.array(
@@ -431,6 +435,28 @@ class NavigateVectorEnv(VectorEnv):
     def env_info(self, i: int) -> Dict[str, Any]:
         """The single-environment info dict of environment ``i`` (outcome name, metrics, ...)."""
         return self._core.env_info(i)
+
+
+class OutcomeCodes(np.ndarray):
+    """The vector environment's ``info["outcome"]``: int8 indices into ``verti.OUTCOMES``, -1
+    while running. The single environment names its outcome, so ``info["outcome"] == "success"``
+    would silently match nothing here; comparing these codes with a string raises instead,
+    saying what to compare with (``verti.OUTCOMES.index("success")``, or ``outcome_name``)."""
+
+    def _refuse(self, other: object) -> None:
+        if isinstance(other, str):
+            raise TypeError(
+                f'info["outcome"] of the vector environment holds codes, not names: compare with '
+                f"verti.OUTCOMES.index({other!r}) (or map codes through verti.envs.outcome_name)"
+            )
+
+    def __eq__(self, other: object) -> Any:
+        self._refuse(other)
+        return np.ndarray.__eq__(self, other)
+
+    def __ne__(self, other: object) -> Any:
+        self._refuse(other)
+        return np.ndarray.__ne__(self, other)
 
 
 def outcome_name(code: int) -> Optional[str]:

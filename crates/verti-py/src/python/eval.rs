@@ -171,9 +171,37 @@ pub(super) fn params_arg(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String
 
 /// Runs `system` on the selected tasks, `jobs` trials at a time, and returns one dict per
 /// trial (the fields of `results.jsonl`), sorted by task. With `out`, results are also written
-/// there, resumable like `verti eval`. Ctrl-C stops it. `system` is a built-in system's name
-/// (default `pid`) or a Python object with `reset(task)` and `act(obs)` (see `pysystem`), which
-/// runs one trial at a time through the same trial code.
+/// there, resumable like `verti eval`. Ctrl-C stops it.
+///
+/// Arguments:
+///
+/// - system: a built-in system's name (default "pid"; `verti.systems()` lists them), or a
+///   Python object with `reset(task)` and `act(obs)`, run one trial at a time through the same
+///   trial code. `act` returns (target speed m/s, steering in [-1, 1]), or with
+///   `action_mode = "low"` (throttle, brake, steering). Optional attributes: `name`,
+///   `control_rate` (Hz), `action_mode`, `state_features`, `lookahead`, `elevation`,
+///   `semantic`, `occupancy` (the observation the object asks for).
+/// - worlds: a set by name ("verti-100", the default; "verti-N-sSEED"; a saved set, a world
+///   directory or a folder of Verti-Bench worlds), "SET:INDEX" for one world, a World or a
+///   list of Worlds. A set by name builds only the worlds of the selected tasks.
+/// - tasks: task numbers, as "1-10,15", an int, a sequence or an array of ints; None for all.
+/// - jobs: trials run at once (default: one per core; a Python system runs one at a time).
+/// - vehicle: a built-in vehicle's name or a vehicle YAML file (default: the vehicle for the
+///   worlds' scale).
+/// - params: a built-in system's parameters, as {name: value} or (name, value) pairs; each is
+///   checked against its declared type and range (`verti.systems()`).
+/// - rules: "paper" (default) or "verti-bench" (the reference code's success and failure rules).
+/// - max_time: seconds per trial before a timeout (default 60).
+/// - seed: the seed of every random draw (default 0): same seed, same results.
+/// - scale: the scale to build named worlds at (1, 1/6, 1/10, ...; default 1).
+/// - start: "settled" (default: the vehicle starts at rest on the ground) or "drop"
+///   (Verti-Bench's spawn above the ground).
+/// - out: a folder for `results.jsonl` and `run.json`, created if missing (its parent must
+///   exist).
+/// - resume: continue the run in `out`, skipping finished tasks.
+/// - force: discard the run in `out` and start over.
+/// - perception: "none" (default), a preset ("low", "medium", "high") or a perception YAML
+///   file: noise on what the system observes.
 #[pyfunction]
 #[pyo3(signature = (system = None, worlds = None, tasks = None, jobs = None, *, vehicle = None, params = None, rules = "paper", max_time = 60.0, seed = 0, scale = None, start = "settled", out = None, resume = false, force = false, perception = "none"))]
 #[allow(clippy::too_many_arguments)]

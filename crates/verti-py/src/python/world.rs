@@ -496,12 +496,13 @@ pub(super) fn image_to_numpy(
 /// Every world of a set given by name (`verti-100`, `verti-20-s7`, a saved set directory, a
 /// world directory or a folder of Verti-Bench worlds). Ctrl-C stops generation.
 #[pyfunction]
-#[pyo3(signature = (spec = "verti-100".to_string(), scale = None))]
+#[pyo3(signature = (spec = "verti-100", scale = None))]
 pub(super) fn load_worlds(
     py: Python<'_>,
-    spec: String,
+    spec: &str,
     scale: Option<f64>,
 ) -> PyResult<Vec<PyWorld>> {
+    let spec = spec.to_string();
     if let Some(s) = scale {
         verti_world::scale::check_scale(s).map_err(world_err)?;
     }
@@ -597,7 +598,7 @@ pub(super) fn worlds_arg(
         let worlds = if is_world {
             vec![PyWorld::resolve(py, spec.clone(), scale)?]
         } else {
-            load_worlds(py, spec.clone(), scale)?
+            load_worlds(py, &spec, scale)?
         };
         return Ok((worlds.into_iter().map(|w| w.inner).collect(), spec));
     }
