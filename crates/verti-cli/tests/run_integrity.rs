@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{fails, ok, s, tmp, verti};
+use common::{fails, ok, run_json, s, tmp, verti};
 use std::path::{Path, PathBuf};
 
 fn lines(path: &Path) -> Vec<String> {
@@ -12,10 +12,6 @@ fn lines(path: &Path) -> Vec<String> {
         .lines()
         .map(str::to_string)
         .collect()
-}
-
-fn run_json(dir: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap()
 }
 
 /// Item 1: a vehicle so light that its simulation blows up at once makes every trial an

@@ -2,24 +2,8 @@
 
 mod common;
 
-use common::{ok, s, tmp, verti};
+use common::{ok, results, s, tmp, verti};
 use std::path::{Path, PathBuf};
-
-/// Results by task, without the wall time (the one field that differs between runs).
-fn results(dir: &Path) -> Vec<serde_json::Value> {
-    let text = std::fs::read_to_string(dir.join("results.jsonl")).unwrap();
-    let mut rows: Vec<serde_json::Value> = text
-        .lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
-            v.as_object_mut().unwrap().remove("wall_time");
-            v
-        })
-        .collect();
-    rows.sort_by_key(|v| v["task"].as_u64());
-    rows
-}
 
 #[test]
 fn shards_merge_into_what_one_run_writes() {

@@ -5,39 +5,20 @@
 
 mod common;
 
-use common::{fails, ok, s, tmp};
+use common::{fails, ok, results, run_json, s, tmp};
 use std::path::Path;
 use std::process::Command;
 
-/// Results by task, without the wall time (the one field that differs between runs).
-fn results(dir: &Path) -> Vec<serde_json::Value> {
-    let text = std::fs::read_to_string(dir.join("results.jsonl")).unwrap();
-    let mut rows: Vec<serde_json::Value> = text
-        .lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
-            v.as_object_mut().unwrap().remove("wall_time");
-            v
-        })
-        .collect();
-    rows.sort_by_key(|v| v["task"].as_u64());
-    rows
-}
-
-fn record(dir: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap()
-}
-
 /// The worlds whose digests `run.json` records one by one.
 fn recorded_worlds(dir: &Path) -> Vec<String> {
-    record(dir)["world_digests"]
+    run_json(dir)["world_digests"]
         .as_object()
         .map(|m| m.keys().cloned().collect())
         .unwrap_or_default()
 }
 
-fn eval(out: &Path, tasks: &str, extra: &[&str]) -> String {
+/// `verti eval` of PID on verti-3's `tasks` into `out`, with `extra` arguments.
+fn eval_args<'a>(out: &'a Path, tasks: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
         "eval",
         "--system",
@@ -54,7 +35,11 @@ fn eval(out: &Path, tasks: &str, extra: &[&str]) -> String {
         s(out),
     ];
     args.extend_from_slice(extra);
-    ok(&args)
+    args
+}
+
+fn eval(out: &Path, tasks: &str, extra: &[&str]) -> String {
+    ok(&eval_args(out, tasks, extra))
 }
 
 #[test]
@@ -62,7 +47,7 @@ fn selected_tasks_build_only_their_worlds_and_end_as_in_the_whole_set() {
     let root = tmp("some-worlds", "alike");
     let (whole, some) = (root.join("whole"), root.join("some"));
     eval(&whole, "all", &[]);
-    let whole_record = record(&whole);
+    let whole_record = run_json(&whole);
     assert!(whole_record["worlds_digest"].is_string());
     assert!(whole_record.get("world_digests").is_none());
     let same_tasks = |tasks: &[u64]| -> Vec<serde_json::Value> {
@@ -74,7 +59,7 @@ fn selected_tasks_build_only_their_worlds_and_end_as_in_the_whole_set() {
 
     // tasks 11 and 12 lie on world 2: only it is built and recorded
     eval(&some, "11-12", &[]);
-    assert!(record(&some).get("worlds_digest").is_none());
+    assert!(run_json(&some).get("worlds_digest").is_none());
     assert_eq!(recorded_worlds(&some), ["2"]);
     assert_eq!(results(&some), same_tasks(&[11, 12]));
 
@@ -94,32 +79,19 @@ fn selected_tasks_build_only_their_worlds_and_end_as_in_the_whole_set() {
     // by the set's digest
     eval(&whole, "1-2", &["--resume"]);
     assert_eq!(
-        record(&whole)["worlds_digest"],
+        run_json(&whole)["worlds_digest"],
         whole_record["worlds_digest"]
     );
 
     // a world whose contents changed is refused by name
-    let mut tampered = record(&some);
+    let mut tampered = run_json(&some);
     tampered["world_digests"]["2"] = "0123456789abcdef".into();
     std::fs::write(
         some.join("run.json"),
         serde_json::to_string_pretty(&tampered).unwrap(),
     )
     .unwrap();
-    let e = fails(&[
-        "eval",
-        "--system",
-        "pid",
-        "--worlds",
-        "verti-3",
-        "--tasks",
-        "11",
-        "--max-time",
-        "20",
-        "--out",
-        s(&some),
-        "--resume",
-    ]);
+    let e = fails(&eval_args(&some, "11", &["--resume"]));
     assert!(
         e.contains("cannot resume") && e.contains("its contents differ (world(s) 2 of"),
         "{e}"
@@ -141,8 +113,8 @@ fn shards_reports_and_replays_of_selected_tasks() {
     eval(&one, "1-20", &[]);
     assert_eq!(results(&merged), results(&one));
     assert_eq!(
-        record(&merged)["world_digests"],
-        record(&one)["world_digests"]
+        run_json(&merged)["world_digests"],
+        run_json(&one)["world_digests"]
     );
 
     // runs of one system with the same settings on different tasks report as one column

@@ -11,7 +11,9 @@
 use crate::error::{Result, WorldError};
 use crate::format::{MANIFEST, SET_MANIFEST, load_set, load_world};
 use crate::generate::{SetConfig, generate_set, set_name};
-use crate::import_vb::{ImportOptions, import_vb, index_from_config_name, scan_vb_dir};
+use crate::import_vb::{
+    ImportOptions, VbWorldFiles, import_vb, index_from_config_name, scan_vb_dir,
+};
 use crate::world::World;
 use rayon::prelude::*;
 use std::path::Path;
@@ -101,27 +103,7 @@ pub fn resolve_set(spec: &str, scale: f64, progress: &(dyn Fn() + Sync)) -> Resu
     }
     if path.is_dir() && has_vb_configs(path) {
         let files = scan_vb_dir(path)?;
-        let opts = ImportOptions {
-            scale,
-            ..Default::default()
-        };
-        let worlds = files
-            .par_iter()
-            .map(|f| {
-                let w = import_vb(&f.config, &f.heightmap, f.labels.as_deref(), &opts);
-                progress();
-                w
-            })
-            .collect::<Result<Vec<_>>>()?;
-        let name = path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .unwrap_or("verti-bench")
-            .to_string();
-        return Ok(WorldSet {
-            name: format!("vb-{name}"),
-            worlds,
-        });
+        return import_vb_set(path, &files.iter().collect::<Vec<_>>(), scale, progress);
     }
     // a built-in name wins over a directory of that name that holds no set (see
     // builtin_shadow_note); `./verti-100` always means the directory
@@ -175,27 +157,7 @@ pub fn resolve_set_worlds(
         if chosen.len() != indices.len() {
             return resolve_set(spec, scale, progress);
         }
-        let opts = ImportOptions {
-            scale,
-            ..Default::default()
-        };
-        let worlds = chosen
-            .par_iter()
-            .map(|f| {
-                let w = import_vb(&f.config, &f.heightmap, f.labels.as_deref(), &opts);
-                progress();
-                w
-            })
-            .collect::<Result<Vec<_>>>()?;
-        let name = path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .unwrap_or("verti-bench")
-            .to_string();
-        return Ok(WorldSet {
-            name: format!("vb-{name}"),
-            worlds,
-        });
+        return import_vb_set(path, &chosen, scale, progress);
     }
     if let Some(config) = builtin_config(spec, scale) {
         config.validate()?;
@@ -220,6 +182,36 @@ pub fn resolve_set_worlds(
         });
     }
     resolve_set(spec, scale, progress)
+}
+
+/// The set `vb-DIR` of the Verti-Bench worlds `files` of folder `dir`, imported in parallel at
+/// `scale`.
+fn import_vb_set(
+    dir: &Path,
+    files: &[&VbWorldFiles],
+    scale: f64,
+    progress: &(dyn Fn() + Sync),
+) -> Result<WorldSet> {
+    let opts = ImportOptions {
+        scale,
+        ..Default::default()
+    };
+    let worlds = files
+        .par_iter()
+        .map(|f| {
+            let w = import_vb(&f.config, &f.heightmap, f.labels.as_deref(), &opts);
+            progress();
+            w
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let name = dir
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("verti-bench");
+    Ok(WorldSet {
+        name: format!("vb-{name}"),
+        worlds,
+    })
 }
 
 /// Resolves a single world: a world directory or `SET:INDEX` (1-based index).

@@ -109,9 +109,7 @@ pub(super) fn separate_runs(
             let clash = a.some_worlds()
                 && b.some_worlds()
                 && identity[i] == identity[j]
-                && a.world_digests
-                    .iter()
-                    .any(|(w, d)| b.world_digests.get(w).is_some_and(|e| e != d));
+                && !a.worlds_differing_from(b).is_empty();
             if clash {
                 for (k, r) in [(i, a), (j, b)] {
                     let hex = verti_core::digest::Digest::new()

@@ -273,6 +273,16 @@ impl RunRecord {
             || self.vehicle_digest.is_none()
     }
 
+    /// The worlds both runs recorded one by one whose digests differ, by index (runs of selected
+    /// tasks compare on the worlds both hold).
+    pub fn worlds_differing_from(&self, other: &RunRecord) -> Vec<u32> {
+        self.world_digests
+            .iter()
+            .filter(|(i, d)| other.world_digests.get(i).is_some_and(|e| e != *d))
+            .map(|(i, _)| *i)
+            .collect()
+    }
+
     /// Whether the run recorded only its tasks' worlds ([`RunRecord::world_digests`]), not the
     /// whole set's digest.
     pub fn some_worlds(&self) -> bool {
@@ -298,10 +308,9 @@ impl RunRecord {
             (Some(_), Some(_)) => {}
             _ if recorded.some_worlds() && self.some_worlds() => {
                 let differing: Vec<String> = recorded
-                    .world_digests
+                    .worlds_differing_from(self)
                     .iter()
-                    .filter(|(i, d)| self.world_digests.get(i).is_some_and(|e| e != *d))
-                    .map(|(i, _)| i.to_string())
+                    .map(u32::to_string)
                     .collect();
                 if !differing.is_empty() {
                     out.push(format!(
