@@ -98,10 +98,7 @@ pub fn prepare(
     let set: Vec<Arc<World>> = match worlds {
         ReplayWorlds::Given(set) => set,
         ReplayWorlds::Named(spec) => {
-            let one_world = spec
-                .rsplit_once(':')
-                .is_some_and(|(_, i)| i.parse::<u32>().is_ok());
-            let resolved = if one_world {
+            let resolved = if verti_world::sets::split_world_index(&spec).is_some() {
                 verti_world::sets::resolve_world(&spec, run.scale).map(|w| vec![w])
             } else {
                 verti_world::sets::resolve_set(&spec, run.scale, &|| {}).map(|s| s.worlds)

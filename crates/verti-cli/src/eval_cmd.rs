@@ -290,21 +290,13 @@ impl Loaded {
     /// was asked (a saved set is read whole): those are kept only when it lacks a world asked
     /// for, so that the task check names the set's real range.
     fn new(worlds: Vec<World>, needed: Option<&BTreeSet<u32>>) -> Self {
-        let has_all =
-            |n: &BTreeSet<u32>| n.iter().all(|i| worlds.iter().any(|w| w.meta.index == *i));
-        match needed {
-            Some(n) if has_all(n) => Loaded {
-                worlds: worlds
-                    .into_iter()
-                    .filter(|w| n.contains(&w.meta.index))
-                    .map(Arc::new)
-                    .collect(),
-                whole: false,
-            },
-            _ => Loaded {
-                worlds: worlds.into_iter().map(Arc::new).collect(),
-                whole: true,
-            },
+        let (worlds, whole) = match needed {
+            Some(n) => verti_world::sets::keep_worlds(worlds, n),
+            None => (worlds, true),
+        };
+        Loaded {
+            worlds: worlds.into_iter().map(Arc::new).collect(),
+            whole,
         }
     }
 

@@ -68,10 +68,7 @@ fn is_world_source(path: &Path) -> bool {
 /// note to show the user. Without it an empty `./verti-100` silently turned `verti-100` into
 /// an error about Verti-Bench configs.
 pub fn builtin_shadow_note(spec: &str) -> Option<String> {
-    let set = match spec.rsplit_once(':') {
-        Some((set, index)) if index.parse::<u32>().is_ok() => set,
-        _ => spec,
-    };
+    let set = split_world_index(spec).map_or(spec, |(set, _)| set);
     let path = Path::new(set);
     (builtin_config(set, 1.0).is_some() && present(path) && !is_world_source(path)).then(|| {
         format!(
@@ -128,6 +125,34 @@ pub fn resolve_set(spec: &str, scale: f64, progress: &(dyn Fn() + Sync)) -> Resu
     Err(WorldError::Argument(format!(
         "unknown world set `{spec}`: expected `verti-100` (built-in), a set directory (with set.yaml), a world directory (with world.yaml) or a folder of Verti-Bench configs"
     )))
+}
+
+/// `SET:INDEX` as the set and the world's 1-based index, when `spec` names one world of a set
+/// that way; `None` for anything else (a set, a world directory).
+pub fn split_world_index(spec: &str) -> Option<(&str, u32)> {
+    let (set, index) = spec.rsplit_once(':')?;
+    index.parse().ok().map(|index| (set, index))
+}
+
+/// The worlds a run of selected tasks keeps of those [`resolve_set_worlds`] returned, and
+/// whether they are the whole set: the worlds in `indices` when all of them are there, else
+/// everything (a saved set is read whole; one lacking a world asked for is kept whole so that
+/// the run's task check names the set's real range).
+pub fn keep_worlds(
+    worlds: Vec<World>,
+    indices: &std::collections::BTreeSet<u32>,
+) -> (Vec<World>, bool) {
+    let has_all = indices
+        .iter()
+        .all(|i| worlds.iter().any(|w| w.meta.index == *i));
+    if !has_all {
+        return (worlds, true);
+    }
+    let kept = worlds
+        .into_iter()
+        .filter(|w| indices.contains(&w.meta.index))
+        .collect();
+    (kept, false)
 }
 
 /// The worlds of set `spec` with the given indices, for a run of selected tasks (a task's world
@@ -300,6 +325,20 @@ mod tests {
         let beyond = std::collections::BTreeSet::from([2, 7]);
         let all = resolve_set_worlds("verti-6", 1.0, &beyond, &|| {}).unwrap();
         assert_eq!(all.worlds.len(), 6);
+        // what a run keeps: the two asked for out of a whole set, or all six when one is missing
+        let (kept, whole) = keep_worlds(set.worlds.clone(), &pick);
+        assert_eq!((kept, whole), (some.worlds, false));
+        let (kept, whole) = keep_worlds(set.worlds, &beyond);
+        assert_eq!((kept.len(), whole), (6, true));
+    }
+
+    #[test]
+    fn set_index_names_one_world() {
+        assert_eq!(split_world_index("verti-100:42"), Some(("verti-100", 42)));
+        assert_eq!(split_world_index("runs/w:3"), Some(("runs/w", 3)));
+        for not_one in ["verti-100", "verti-100:x", "verti-100:-1", "dir/world"] {
+            assert_eq!(split_world_index(not_one), None, "{not_one}");
+        }
     }
 
     #[test]

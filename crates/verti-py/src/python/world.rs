@@ -547,10 +547,9 @@ pub(super) fn some_worlds_arg(
 ) -> PyResult<(Vec<Arc<World>>, String, bool)> {
     let set_name = arg.cast::<PyString>().ok().and_then(|s| {
         let spec: String = s.extract().ok()?;
-        let one_world = spec
-            .rsplit_once(':')
-            .is_some_and(|(_, i)| i.parse::<u32>().is_ok());
-        (!one_world).then_some(spec)
+        verti_world::sets::split_world_index(&spec)
+            .is_none()
+            .then_some(spec)
     });
     let (Some(spec), Some(only)) = (set_name, only) else {
         let (worlds, name) = worlds_arg(py, arg, scale)?;
@@ -566,18 +565,8 @@ pub(super) fn some_worlds_arg(
         Ok(set)
     })?
     .map_err(world_err)?;
-    // a saved set is read whole: keep only the worlds asked for, unless one is missing (then
-    // the task check names the set's real range)
-    let has_all = only
-        .iter()
-        .all(|i| set.worlds.iter().any(|w| w.meta.index == *i));
-    let worlds: Vec<Arc<World>> = set
-        .worlds
-        .into_iter()
-        .filter(|w| !has_all || only.contains(&w.meta.index))
-        .map(Arc::new)
-        .collect();
-    Ok((worlds, spec, !has_all))
+    let (worlds, whole) = verti_world::sets::keep_worlds(set.worlds, only);
+    Ok((worlds.into_iter().map(Arc::new).collect(), spec, whole))
 }
 
 /// Worlds from a Python argument: a World, a list of Worlds or a name (see `load_worlds`;
@@ -591,9 +580,7 @@ pub(super) fn worlds_arg(
 ) -> PyResult<(Vec<Arc<World>>, String)> {
     if let Ok(s) = arg.cast::<PyString>() {
         let spec: String = s.extract()?;
-        let is_world = spec
-            .rsplit_once(':')
-            .is_some_and(|(_, i)| i.parse::<u32>().is_ok())
+        let is_world = verti_world::sets::split_world_index(&spec).is_some()
             || std::path::Path::new(&spec).join("world.yaml").is_file();
         let worlds = if is_world {
             vec![PyWorld::resolve(py, spec.clone(), scale)?]
