@@ -281,6 +281,24 @@ impl VehicleSpec {
                 ""
             }
         );
+        // the origin is what systems steer and the rules judge: say where it is on the vehicle
+        let first = self.axles.first().map_or(0.0, |a| a.x);
+        let last = self.axles.last().map_or(0.0, |a| a.x);
+        let mid = (first + last) / 2.0;
+        let place = if mid.abs() < 5e-4 {
+            "mid-way between the first and last axles".to_string()
+        } else {
+            format!(
+                "{:.3} m {} mid-way between the first and last axles",
+                mid.abs(),
+                if mid < 0.0 { "ahead of" } else { "behind" }
+            )
+        };
+        let _ = writeln!(
+            s,
+            "  position         the origin, {place}: systems steer it along the path and the goal is judged there (centre of mass at x {:+.3} m)",
+            self.chassis.com[0]
+        );
         for (i, a) in self.axles.iter().enumerate() {
             let _ = writeln!(
                 s,

@@ -43,22 +43,23 @@ fn builtin_vehicles_load_and_unknown_names_list_the_known_ones() {
 }
 
 /// A vehicle file's origin is the point systems see as the vehicle's position (they steer it
-/// along the path; the rules judge the goal there). On the HMMWV, the Gator, the Sedan and the
-/// M113 it lies mid-way between the first and last axles (the HMMWV's 2.4 mm ahead, Chrono's
-/// own); the UAZ, the trucks, the ARTcar and the Verti-4 keep Chrono's origin on the front axle.
-/// A change here moves every result of that vehicle, so it is pinned.
+/// along the path; the rules judge the goal there): on every shipped vehicle it lies mid-way
+/// between the first and last axles, the span systems are given as the wheelbase (the HMMWV's,
+/// Chrono's own, 2.4 mm behind it). A change here moves every result of that vehicle.
 #[test]
-fn each_vehicle_origin_is_where_its_file_says() {
+fn every_vehicle_origin_is_mid_way_along_its_wheelbase() {
     for name in vehicles::builtin_names() {
         let spec = vehicles::builtin(name).unwrap();
         let (first, last) = (spec.axles[0].x, spec.axles[spec.axles.len() - 1].x);
         let mid = (first + last) / 2.0;
-        match name {
-            "hmmwv" | "hmmwv-handling" | "gator" | "sedan" | "m113" => {
-                assert!(mid.abs() < 0.003, "{name}: mid-span at x = {mid}")
-            }
-            _ => assert_eq!(first, 0.0, "{name}: front axle at x = {first}"),
-        }
+        assert!(mid.abs() < 0.003, "{name}: mid-span at x = {mid}");
+        assert!((first - last - spec.wheelbase()).abs() < 1e-12);
+        // `verti vehicle show` says where the point is
+        let summary = spec.summary();
+        assert!(
+            summary.contains("mid-way between the first and last axles"),
+            "{summary}"
+        );
     }
 }
 
