@@ -37,22 +37,17 @@ pub fn world_digest(world: &World) -> String {
 /// Digest of a world set: its worlds' digests in index order (the order worlds were listed in
 /// does not change what a run covers).
 pub fn set_digest(worlds: &[Arc<World>]) -> String {
-    use rayon::prelude::*;
-    let mut each: Vec<(u32, String)> = worlds
-        .par_iter()
-        .map(|w| (w.meta.index, world_digest(w)))
-        .collect();
-    each.sort();
+    let each = world_digests(worlds);
     let mut d = Digest::new();
     d.u64(each.len() as u64);
     for (index, digest) in &each {
-        d.u64(*index as u64).str(digest);
+        d.u64(u64::from(*index)).str(digest);
     }
     d.hex()
 }
 
 /// [`world_digest`] of each world, by index: what a run of selected tasks records when it
-/// loaded only the worlds they are on.
+/// loaded only the worlds they are on (and what [`set_digest`] folds into one).
 pub fn world_digests(worlds: &[Arc<World>]) -> BTreeMap<u32, String> {
     use rayon::prelude::*;
     worlds
