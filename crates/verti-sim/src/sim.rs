@@ -53,7 +53,8 @@ impl Sim {
     }
 
     /// The state of Verti-Bench's spawn at `start`: level, the chassis reference frame
-    /// `height` above the ground, at rest, springs at their static compression and tyres
+    /// `height` above the ground (higher where that would start the body or a wheel inside
+    /// rigid ground beside it), at rest, springs at their static compression and tyres
     /// undeflected, ready to fall onto the terrain (see `start::dropped`).
     pub fn state_dropped(&self, start: StartPose, height: f64) -> Result<SimState, SimError> {
         let pose = dropped(&self.terrain.world, &self.spec, start, height)?;

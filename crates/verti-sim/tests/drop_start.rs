@@ -73,3 +73,37 @@ fn a_drop_start_is_checked_like_any_start() {
         .to_string();
     assert!(e.contains("off the map"), "{e}");
 }
+
+/// Level and 1 m up, a HMMWV spawned across a 45.8° slope has its uphill wheels half a metre
+/// inside the ground, and the stiff contact would throw it. The spawn is lifted until nothing starts inside
+/// rigid ground (just touching), so the vehicle falls as on level ground instead.
+#[test]
+fn a_drop_start_on_a_steep_spot_is_lifted_clear_of_the_ground_and_not_thrown() {
+    let slope = 0.8;
+    let sim = sim(testing::plane_world(1.0, 0.0, slope, 0.8), "hmmwv");
+    let mut st = sim
+        .state_dropped(StartPose::new(0.0, 0.0, 0.0), 1.0)
+        .unwrap();
+    let pose = sim.reference_pose(&st);
+    // the ground is z = tan(slope) * y; the uphill wheels' lowest rim points touch first
+    let spec = vehicles::builtin("hmmwv").unwrap();
+    let lowest_gap = sim
+        .wheel_centers(&st)
+        .iter()
+        .zip(spec.axles.iter().flat_map(|a| [a, a]))
+        .map(|(c, ax)| {
+            // the rim's lowest point over the wheel's width, against the plane
+            let uphill = c.y + 0.5 * ax.wheel.width;
+            c.z - ax.wheel.radius - slope.tan() * uphill
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!(pose.position.z > 1.15, "not lifted: {:?}", pose.position);
+    assert!(
+        lowest_gap > -1e-3 && lowest_gap < 0.03,
+        "the lowest wheel should just touch: gap {lowest_gap} m"
+    );
+    // it falls, not flies: after 20 ms its centre of mass moves down
+    sim.step(&mut st, Controls::IDLE, 0.02).unwrap();
+    let vz = st.velocity_world().z;
+    assert!(vz < 0.05, "thrown up at {vz} m/s");
+}
