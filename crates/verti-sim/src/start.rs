@@ -141,8 +141,9 @@ pub(crate) fn dropped(
 
 /// How deep the lowest part of the vehicle at `pose` (the chassis box's bottom face and the
 /// wheels' lower rims, springs at static compression, tyres undeflected) lies below rigid ground,
-/// or 0 if nothing does. Soil does not count: a wheel starts sunk in it and the hull passes
-/// through it anyway.
+/// or 0 if nothing does. Sampled, not exact: the face every half cell (a terrain vertex between
+/// samples can still poke a few centimetres into it), each rim every 10° along its edges and
+/// middle. Soil does not count: a wheel starts sunk in it and the hull passes through it anyway.
 fn rigid_overlap(world: &World, spec: &VehicleSpec, pose: Pose) -> f64 {
     let comp = static_compressions(spec);
     let bx = &spec.chassis.collision_box;
