@@ -1,7 +1,14 @@
-"""Re-runs, in committed evaluations, only the tasks on one terrain type, after an engine change
-that provably touches no other (e.g. the rigid/soil edges, which exist only on mixed worlds).
+"""Re-runs, in committed evaluations, only the tasks on one terrain type, or only given tasks,
+after an engine change that provably touches no other (e.g. the rigid/soil edges, which exist
+only on mixed worlds; a change of the settled start, which moves only some starts).
 
     python3 scripts/rerun_terrain.py --bin target/release/verti --terrain mixed [RUN_DIR ...]
+    python3 scripts/rerun_terrain.py --bin target/release/verti \
+        --tasks hmmwv@verti-100=671,690 --tasks m113@verti-100=28,76 [RUN_DIR ...]
+
+`--tasks VEHICLE@WORLDS=LIST` names the tasks to redo in runs of that vehicle on that world set
+(`worlds` as run.json records it); a run's other tasks, and runs of other vehicles or sets,
+are left alone.
 
 For each run folder (default: every benchmarks/**/run.json whose results hold such tasks) it
 removes those tasks' results, lets `verti eval --resume --out DIR` recompute them from the
@@ -53,11 +60,22 @@ def eval_args(run):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--bin", required=True, help="the verti binary to evaluate with")
-    ap.add_argument("--terrain", required=True, choices=["rigid", "deformable", "mixed"])
+    ap.add_argument("--terrain", choices=["rigid", "deformable", "mixed"])
+    ap.add_argument("--tasks", action="append", default=[], metavar="VEHICLE@WORLDS=LIST",
+                    help="redo these tasks (comma-separated) in runs of VEHICLE on WORLDS")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--skip", action="append", default=[], help="skip run folders containing this")
     ap.add_argument("runs", nargs="*", help="run folders (default: all under benchmarks/)")
     args = ap.parse_args()
+    if (args.terrain is None) == (not args.tasks):
+        ap.error("give --terrain or --tasks (one of them)")
+    chosen = {}
+    for spec in args.tasks:
+        key, _, numbers = spec.rpartition("=")
+        vehicle, _, worlds = key.partition("@")
+        if not (vehicle and worlds and numbers):
+            ap.error(f"--tasks {spec}: expected VEHICLE@WORLDS=LIST")
+        chosen[(vehicle, worlds)] = {int(n) for n in numbers.split(",") if n}
     root = Path(__file__).resolve().parent.parent
     runs = [Path(r) for r in args.runs] or sorted(
         p.parent for p in (root / "benchmarks").rglob("run.json")
@@ -71,7 +89,12 @@ def main():
             print(f"{run}: no results.jsonl (bash scripts/benchmarks.sh unpack)", file=sys.stderr)
             sys.exit(2)
         rs = lines(results)
-        keep = [(line, r) for line, r in rs if r.get("terrain_type") != args.terrain]
+        if args.terrain:
+            keep = [(line, r) for line, r in rs if r.get("terrain_type") != args.terrain]
+        else:
+            rec = json.loads((run / "run.json").read_text())
+            redo_tasks = chosen.get((rec["vehicle"], rec["worlds"]), set())
+            keep = [(line, r) for line, r in rs if r["task"] not in redo_tasks]
         redo = len(rs) - len(keep)
         if redo == 0:
             continue
@@ -93,7 +116,8 @@ def main():
             sys.exit(1)
         with results.open("w") as f:
             f.writelines(line for line, _ in after)
-        print(f"{run}: {redo} {args.terrain} tasks in {time.time() - start:.0f} s", flush=True)
+        what = args.terrain or "chosen"
+        print(f"{run}: {redo} {what} tasks in {time.time() - start:.0f} s", flush=True)
 
 
 if __name__ == "__main__":
