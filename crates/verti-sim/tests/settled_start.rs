@@ -59,8 +59,8 @@ fn on_flat_ground_the_tyres_carry_the_vehicle_at_their_static_deflection() {
     }
 }
 
-/// A ridge 0.6 m high along the M113's centre line, between its tracks, stands 0.18 m into
-/// its hull: set down on its road wheels, the hull's contacts would throw it up at metres per
+/// A ridge 0.6 m high along the M113's centre line, between its tracks, reaches 0.23 m into
+/// its hull (0.37 m above the ground): set down on its road wheels, the hull's contacts would throw it up at metres per
 /// second. It is raised instead until the hull carries the weight, resting on the ridge.
 #[test]
 fn a_hull_over_a_ridge_is_raised_onto_it_and_not_thrown() {
