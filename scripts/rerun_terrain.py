@@ -73,9 +73,13 @@ def main():
     for spec in args.tasks:
         key, _, numbers = spec.rpartition("=")
         vehicle, _, worlds = key.partition("@")
-        if not (vehicle and worlds and numbers):
-            ap.error(f"--tasks {spec}: expected VEHICLE@WORLDS=LIST")
-        chosen[(vehicle, worlds)] = {int(n) for n in numbers.split(",") if n}
+        try:
+            tasks = {int(n) for n in numbers.split(",") if n}
+        except ValueError:
+            tasks = set()
+        if not (vehicle and worlds and tasks):
+            ap.error(f"--tasks {spec}: expected VEHICLE@WORLDS=LIST (LIST: task numbers, comma-separated)")
+        chosen[(vehicle, worlds)] = tasks
     root = Path(__file__).resolve().parent.parent
     runs = [Path(r) for r in args.runs] or sorted(
         p.parent for p in (root / "benchmarks").rglob("run.json")

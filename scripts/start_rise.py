@@ -15,21 +15,29 @@ Prints one line per vehicle and, with --list, the starts.
 """
 
 import argparse
+import re
+from pathlib import Path
 
 import verti
 
-SCALES = {"artcar": 1.0 / 6.0, "verti4": 0.1}
+VEHICLES = Path(__file__).resolve().parent.parent / "crates/verti-sim/vehicles"
+
+
+def vehicle_scale(name):
+    """The scale a built-in vehicle drives at: its file's `scale`."""
+    text = (VEHICLES / f"{name}.yaml").read_text()
+    return float(re.search(r"^scale:\s*(\S+)", text, re.M).group(1))
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("vehicles", nargs="*", help="default: every built-in vehicle")
-    parser.add_argument("--list", action="store_true", help="print each start that rose")
+    parser.add_argument("--list", action="store_true", help="print each thrown start")
     parser.add_argument("--threshold", type=float, default=0.3, help="upward speed in m/s at full scale")
     args = parser.parse_args()
     worlds_by_scale = {}
     for vehicle in args.vehicles or verti.vehicles():
-        scale = SCALES.get(vehicle, 1.0)
+        scale = vehicle_scale(vehicle)
         if scale not in worlds_by_scale:
             worlds_by_scale[scale] = verti.load_worlds("verti-100", scale=None if scale == 1.0 else scale)
         rose, worst = [], 0.0
