@@ -10,7 +10,8 @@ cd "$(dirname "$0")/.."
 what=${1:-}
 case "$what" in
 pack)
-    find benchmarks -name results.jsonl | sort | while read -r f; do
+    # runs still being made under benchmarks/in-progress/ are not packed: they are not committed
+    find benchmarks -path benchmarks/in-progress -prune -o -name results.jsonl -print | sort | while read -r f; do
         # -n: no name or time stamp, so an unchanged file packs to the same bytes
         gzip -9 -n -c "$f" > "$f.gz.tmp" && mv "$f.gz.tmp" "$f.gz"
         echo "packed $f ($(wc -l < "$f") results)"

@@ -5,7 +5,8 @@
 # for issue 34, when soil damping took the wheel surface's speed and the chassis passed through soil,
 # and when the edges between rigid patches and soil became curbs and walls: mixed worlds only;
 # and for SCM's bulldozing: deformable and mixed worlds; and when the settled start learnt to
-# raise a hull the ground would push harder than the weight: tasks 671 and 690).
+# raise a hull the ground would push harder than the weight: tasks 671 and 690; and when the
+# HMMWV took its linkages' roll centres: every task).
 #
 #   bash scripts/check_behaviour.sh            # pid (CI runs this; ~20 s of evaluation)
 #   bash scripts/check_behaviour.sh pid eh mppi   # all three (mppi takes ~10 min on 2 cores)

@@ -1,10 +1,12 @@
 """Re-runs, in committed evaluations, only the tasks on one terrain type, or only given tasks,
 after an engine change that provably touches no other (e.g. the rigid/soil edges, which exist
-only on mixed worlds; a change of the settled start, which moves only some starts).
+only on mixed worlds; a change of the settled start, which moves only some starts), or every
+task after a change of the vehicle itself.
 
     python3 scripts/rerun_terrain.py --bin target/release/verti --terrain mixed [RUN_DIR ...]
     python3 scripts/rerun_terrain.py --bin target/release/verti \
         --tasks hmmwv@verti-100=671,690 --tasks m113@verti-100=28,76 [RUN_DIR ...]
+    python3 scripts/rerun_terrain.py --bin target/release/verti --all RUN_DIR ...
 
 `--tasks VEHICLE@WORLDS=LIST` names the tasks to redo in runs of that vehicle on that world set
 (`worlds` as run.json records it); a run's other tasks, and runs of other vehicles or sets,
@@ -17,10 +19,17 @@ The other results stay as they are: run the full evaluation of one cheap system 
 binary and compare digests (`scripts/results_digest.py`) to check that they would come out the
 same. Resumable: a folder already done is recomputed only for tasks still missing. Then
 `bash scripts/benchmarks.sh pack`.
+
+`--all` re-runs every task of each named run (it names no default: say which runs). A changed
+vehicle changes the run's record (its vehicle file and digest), so the run cannot resume in
+place: it is made afresh in benchmarks/in-progress/<the run's path under benchmarks/>, from the
+same arguments, where an interrupted run resumes, and when every task is done its run.json and
+results.jsonl replace the committed ones.
 """
 
 import argparse
 import json
+import shutil
 import subprocess
 import sys
 import time
@@ -63,12 +72,15 @@ def main():
     ap.add_argument("--terrain", choices=["rigid", "deformable", "mixed"])
     ap.add_argument("--tasks", action="append", default=[], metavar="VEHICLE@WORLDS=LIST",
                     help="redo these tasks (comma-separated) in runs of VEHICLE on WORLDS")
+    ap.add_argument("--all", action="store_true", help="redo every task (a changed vehicle)")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--skip", action="append", default=[], help="skip run folders containing this")
     ap.add_argument("runs", nargs="*", help="run folders (default: all under benchmarks/)")
     args = ap.parse_args()
-    if (args.terrain is None) == (not args.tasks):
-        ap.error("give --terrain or --tasks (one of them)")
+    if [args.terrain is not None, bool(args.tasks), args.all].count(True) != 1:
+        ap.error("give --terrain, --tasks or --all (one of them)")
+    if args.all and not args.runs:
+        ap.error("--all re-runs every task: name the run folders")
     chosen = {}
     for spec in args.tasks:
         key, _, numbers = spec.rpartition("=")
@@ -93,6 +105,9 @@ def main():
             print(f"{run}: no results.jsonl (bash scripts/benchmarks.sh unpack)", file=sys.stderr)
             sys.exit(2)
         rs = lines(results)
+        if args.all:
+            redo_all(args, root, run, len(rs))
+            continue
         if args.terrain:
             keep = [(line, r) for line, r in rs if r.get("terrain_type") != args.terrain]
         else:
@@ -122,6 +137,32 @@ def main():
             f.writelines(line for line, _ in after)
         what = args.terrain or "chosen"
         print(f"{run}: {redo} {what} tasks in {time.time() - start:.0f} s", flush=True)
+
+
+def redo_all(args, root, run, count):
+    """Every task of `run` afresh in benchmarks/in-progress/..., then moved over the run."""
+    run = run.resolve()
+    work = root / "benchmarks" / "in-progress" / run.relative_to(root / "benchmarks")
+    work.mkdir(parents=True, exist_ok=True)
+    start = time.time()
+    done = subprocess.run(
+        [args.bin, "eval", *eval_args(run), "--resume", "--out", str(work), "--jobs", str(args.jobs)],
+        capture_output=True,
+        text=True,
+        cwd=root,
+    )
+    if done.returncode != 0:
+        print(f"{run}: verti eval failed:\n{done.stderr}", file=sys.stderr)
+        sys.exit(1)
+    after = sorted(lines(work / "results.jsonl"), key=lambda lr: lr[1]["task"])
+    if len(after) != count:
+        print(f"{run}: {len(after)} results after, {count} before", file=sys.stderr)
+        sys.exit(1)
+    with (run / "results.jsonl").open("w") as f:
+        f.writelines(line for line, _ in after)
+    shutil.copyfile(work / "run.json", run / "run.json")
+    shutil.rmtree(work)
+    print(f"{run}: all {count} tasks in {time.time() - start:.0f} s", flush=True)
 
 
 if __name__ == "__main__":

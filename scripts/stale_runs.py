@@ -1,14 +1,15 @@
 #!/usr/bin/env python3
-"""Which committed runs a results page quotes were made before the engine's latest soil change
-(SCM's bulldozing) on their deformable and mixed tasks, as one paragraph for the page.
+"""Which committed runs a results page quotes were made before an engine change that calls for
+re-runs, as one paragraph per change for the page.
 
     python3 scripts/stale_runs.py docs/src/results/verti-bench.md
 
-The runs still to be re-run are listed, one folder per line, in
-benchmarks/in-progress/before-bulldozing.txt (`scripts/rerun_terrain.py` re-runs them; a folder
-leaves the list when its deformable and mixed tasks have been re-run). A page's runs are the
-runs its `verti report` blocks and `scripts/table_one.py` blocks show and every run folder its
-text names.
+Each change keeps, in benchmarks/in-progress/, a list of the runs still to be re-run, one folder
+per line (`scripts/rerun_terrain.py` re-runs them; a folder leaves the list when its re-run is
+committed): before-bulldozing.txt (SCM's bulldozing: deformable and mixed tasks) and
+before-roll-centres.txt (the HMMWV's roll centres: every task). A page's runs are the runs its
+`verti report` blocks and `scripts/table_one.py` blocks show and every run folder its text
+names.
 """
 
 import re
@@ -18,7 +19,12 @@ from pathlib import Path
 import method_tables
 
 ROOT = Path(__file__).resolve().parent.parent
-LIST = ROOT / "benchmarks/in-progress/before-bulldozing.txt"
+IN_PROGRESS = ROOT / "benchmarks/in-progress"
+# (list, what the change did, which of a run's tasks it touched)
+CHANGES = [
+    ("before-bulldozing.txt", "SCM's bulldozing joined the soil model", "deformable and mixed"),
+    ("before-roll-centres.txt", "the HMMWV took its linkages' roll centres", "all"),
+]
 TABLE_ONE = ["pid", "eh", "mppi", "rl", "mcl", "acl", "wmvct", "mppi6", "tal", "tnt"]
 # what the table scripts read (folder prefixes), where the runs are not named on the page
 SCRIPT_PREFIXES = {
@@ -30,10 +36,16 @@ SCRIPT_PREFIXES = {
 }
 
 
-def stale():
-    if not LIST.exists():
+def stale(list_name):
+    path = IN_PROGRESS / list_name
+    if not path.exists():
         return set()
-    return {line.strip().rstrip("/") for line in LIST.read_text().splitlines() if line.strip() and not line.startswith("#")}
+    return {line.strip().rstrip("/") for line in path.read_text().splitlines() if line.strip() and not line.startswith("#")}
+
+
+def all_stale():
+    """Every run still to be re-run after any change (Table I's † marks them)."""
+    return set().union(*(stale(name) for name, _, _ in CHANGES))
 
 
 def page_runs(text):
@@ -53,12 +65,20 @@ def page_runs(text):
 def main():
     page = Path(sys.argv[1])
     text = page.read_text(encoding="utf-8")
-    old = stale()
     prefixes = [p for script, ps in SCRIPT_PREFIXES.items() if f"scripts/{script}" in text for p in ps]
-    hits = sorted(r for r in old if r in page_runs(text) or any(r.startswith(p) for p in prefixes))
-    if not hits:
-        print("Every run this page quotes includes the latest soil model (SCM's bulldozing).")
+    quoted = page_runs(text)
+    paragraphs = []
+    for list_name, change, tasks in CHANGES:
+        hits = sorted(r for r in stale(list_name) if r in quoted or any(r.startswith(p) for p in prefixes))
+        if hits:
+            paragraphs.append(paragraph(hits, change, tasks))
+    if not paragraphs:
+        print("Every run this page quotes was made with the current engine.")
         return
+    print("\n\n".join(paragraphs))
+
+
+def paragraph(hits, change, tasks):
     if len(hits) <= 8:
         names = ", ".join(f"`{h.removeprefix('benchmarks/')}`" for h in hits)
     else:
@@ -66,13 +86,15 @@ def main():
         for h in hits:
             groups.setdefault(h.removeprefix("benchmarks/").split("/")[0], []).append(h)
         names = ", ".join(f"`{g}/` ({len(v)})" for g, v in sorted(groups.items()))
-    print(
-        f"**Stale on soil:** the deformable and mixed tasks of {len(hits)} run(s) quoted here "
-        f"were made before SCM's bulldozing joined the soil model and are being re-run "
-        f"(`benchmarks/in-progress/README.md`): {names}. Their rigid tasks are current. The "
-        f"generated tables show every other run as re-run; the prose between them was written "
-        f"before bulldozing and is revised once these runs are done: where it quotes a figure "
-        f"the tables no longer show, the tables are right."
+    which = "The tasks" if tasks == "all" else f"The {tasks} tasks"
+    current = "" if tasks == "all" else " Their other tasks are current."
+    return (
+        f"**Stale:** {which} of {len(hits)} run(s) quoted here "
+        f"were made before {change} and are being re-run "
+        f"(`benchmarks/in-progress/README.md`): {names}.{current} The generated tables show "
+        f"every other run as re-run; the prose between them was written before the change and "
+        f"is revised once these runs are done: where it quotes a figure the tables no longer "
+        f"show, the tables are right."
     )
 
 

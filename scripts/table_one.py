@@ -5,13 +5,14 @@ committed runs `benchmarks/SET/<system>` (after `bash scripts/benchmarks.sh unpa
 
 Rows: outcomes (%), success per elevation level, success and rollover on rigid worlds alone,
 mean |roll| on high elevation (each trial's mean absolute roll, averaged over the trials), then
-the paper's Table I. The best success among the ten is bold; † marks a system whose deformable
-and mixed tasks predate SCM's bulldozing (benchmarks/in-progress/before-bulldozing.txt).
+the paper's Table I. The best success among the ten is bold; † marks a system whose run predates
+an engine change that calls for re-runs (the lists in benchmarks/in-progress/, scripts/stale_runs.py).
 """
 
 import sys
 from pathlib import Path
 
+import stale_runs
 from run_rows import rows, share, success_by_level
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -38,9 +39,8 @@ def main():
     missing = [s for s, rs in zip(SYSTEMS, runs) if not rs]
     if missing:
         sys.exit(f"table_one: no results for {', '.join(missing)} (bash scripts/benchmarks.sh unpack)")
-    stale = (ROOT / "benchmarks/in-progress/before-bulldozing.txt")
-    stale = set(stale.read_text().split()) if stale.exists() else set()
-    # † a system whose soil and mixed tasks predate SCM's bulldozing (scripts/stale_runs.py)
+    # † a system whose run predates an engine change that calls for re-runs (scripts/stale_runs.py)
+    stale = stale_runs.all_stale()
     names = [n + ("†" if f"benchmarks/{set_name}/{s}" in stale else "") for n, s in zip(NAMES, SYSTEMS)]
     out = ["| | " + " | ".join(names) + " |", "|---|" + "---:|" * len(NAMES)]
 

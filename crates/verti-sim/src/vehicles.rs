@@ -98,8 +98,8 @@ pub fn mechanisms(name: &str) -> Option<Mechanisms> {
         suspension_families: &[],
         steering_families: &[],
         suspension: "double wishbone (Chrono's reduced double-A-arm), modelled as independent wheels \
-                     sliding straight up and down (roll centre on the ground; Chrono's linkage puts \
-                     it 0.354 m front, 0.407 m rear above the ground: not adopted, see the engine docs)",
+                     sliding straight up and down with the linkage's roll centres (0.354 m front, \
+                     0.407 m rear above the ground, from Chrono's hardpoints)",
         steering: "ideal Ackermann geometry up to 30.23°, the road-wheel angle of Chrono's JSON \
                    HMMWV (Chrono's HMMWV steers by a Pitman arm, the HMMWV_Reduced Verti-Bench \
                    drives by a rack and pinion with a 21.7° bicycle angle at full input; neither \

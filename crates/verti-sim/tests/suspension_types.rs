@@ -110,8 +110,66 @@ fn derived_spring_roll(spec: &VehicleSpec, theta: f64, h: f64) -> f64 {
         / n
 }
 
+// The handling HMMWV with its roll centres taken off, so that what a roll centre or a bar does
+// is measured from independent wheels that carry the whole roll moment on their springs.
 fn handling_hmmwv() -> VehicleSpec {
-    vehicles::builtin("hmmwv-handling").unwrap()
+    let mut spec = vehicles::builtin("hmmwv-handling").unwrap();
+    for ax in &mut spec.axles {
+        ax.roll_centre_height = None;
+    }
+    spec
+}
+
+// The HMMWV's roll centres follow from Chrono's hardpoints (HMMWV_DoubleWishboneReduced
+// {Front,Rear}::getLocation, inches, suspension frame): in the front view each wishbone's
+// chassis axis (taken at its ball joint's x) and ball joint make a line; the two lines meet at
+// the instant centre, and the line from the contact patch (R 0.467 below the spindle) through
+// it crosses the centre line at the roll centre.
+#[test]
+fn the_hmmwvs_roll_centres_follow_from_chronos_hardpoints() {
+    type P = [f64; 3];
+    struct Arms {
+        spindle: P,
+        uca: [P; 3], // front pivot, back pivot, ball joint
+        lca: [P; 3],
+    }
+    let front = Arms {
+        spindle: [-1.59, 35.815, -1.035],
+        uca: [[-1.89, 17.55, 9.63], [-10.56, 18.81, 7.69], [-2.09, 28.16, 8.48]],
+        lca: [[8.79, 12.09, 0.0], [-8.79, 12.09, 0.0], [-1.40, 30.96, -4.65]],
+    };
+    let rear = Arms {
+        spindle: [1.40, 35.815, -1.035],
+        uca: [[13.78, 18.19, 8.88], [3.07, 18.19, 8.88], [1.40, 28.16, 8.50]],
+        lca: [[8.79, 12.09, 0.0], [-8.79, 12.09, 0.0], [1.40, 30.96, -4.65]],
+    };
+    let inch = 0.0254;
+    // (y, z) of the arm's chassis axis at the ball joint's x, and of the ball joint
+    let arm = |[f, b, ball]: [P; 3]| {
+        let t = (ball[0] - f[0]) / (b[0] - f[0]);
+        let inner = [f[1] + t * (b[1] - f[1]), f[2] + t * (b[2] - f[2])];
+        (inner.map(|c| c * inch), [ball[1] * inch, ball[2] * inch])
+    };
+    let roll_centre = |a: &Arms| {
+        let ((p1, q1), (p2, q2)) = (arm(a.uca), arm(a.lca));
+        let (d1, d2) = ([q1[0] - p1[0], q1[1] - p1[1]], [q2[0] - p2[0], q2[1] - p2[1]]);
+        // p1 + s·d1 = p2 + u·d2
+        let det = d2[0] * d1[1] - d1[0] * d2[1];
+        let s = (d2[0] * (p2[1] - p1[1]) - d2[1] * (p2[0] - p1[0])) / det;
+        let ic = [p1[0] + s * d1[0], p1[1] + s * d1[1]];
+        let patch = [a.spindle[1] * inch, a.spindle[2] * inch - 0.467];
+        let z_at_centre = patch[1] - patch[0] * (ic[1] - patch[1]) / (ic[0] - patch[0]);
+        z_at_centre - patch[1]
+    };
+    let derived = [roll_centre(&front), roll_centre(&rear)];
+    println!("derived roll centres: {derived:?}");
+    for name in ["hmmwv", "hmmwv-handling"] {
+        let spec = vehicles::builtin(name).unwrap();
+        for (ax, h) in spec.axles.iter().zip(derived) {
+            let shipped = ax.roll_centre_height.unwrap();
+            assert!((shipped - h).abs() < 5e-4, "{name}: {shipped} vs {h}");
+        }
+    }
 }
 
 #[test]
