@@ -120,21 +120,7 @@ def main():
         start = time.time()
         with results.open("w") as f:
             f.writelines(line for line, _ in keep)
-        done = subprocess.run(
-            [args.bin, "eval", *eval_args(run), "--resume", "--out", str(run), "--jobs", str(args.jobs)],
-            capture_output=True,
-            text=True,
-            cwd=root,
-        )
-        if done.returncode != 0:
-            print(f"{run}: verti eval failed:\n{done.stderr}", file=sys.stderr)
-            sys.exit(1)
-        after = sorted(lines(results), key=lambda lr: lr[1]["task"])
-        if len(after) != len(rs):
-            print(f"{run}: {len(after)} results after, {len(rs)} before", file=sys.stderr)
-            sys.exit(1)
-        with results.open("w") as f:
-            f.writelines(line for line, _ in after)
+        resume_into(args, root, run, run, len(rs))
         what = args.terrain or "chosen"
         print(f"{run}: {redo} {what} tasks in {time.time() - start:.0f} s", flush=True)
 
@@ -145,8 +131,17 @@ def redo_all(args, root, run, count):
     work = root / "benchmarks" / "in-progress" / run.relative_to(root / "benchmarks")
     work.mkdir(parents=True, exist_ok=True)
     start = time.time()
+    resume_into(args, root, run, work, count)
+    shutil.copyfile(work / "run.json", run / "run.json")
+    shutil.rmtree(work)
+    print(f"{run}: all {count} tasks in {time.time() - start:.0f} s", flush=True)
+
+
+def resume_into(args, root, run, out, count):
+    """Let `verti eval --resume --out OUT` finish `run`'s record there, then write OUT's results,
+    sorted by task, as `run`'s (exits if the evaluation fails or the count is not `count`)."""
     done = subprocess.run(
-        [args.bin, "eval", *eval_args(run), "--resume", "--out", str(work), "--jobs", str(args.jobs)],
+        [args.bin, "eval", *eval_args(run), "--resume", "--out", str(out), "--jobs", str(args.jobs)],
         capture_output=True,
         text=True,
         cwd=root,
@@ -154,15 +149,12 @@ def redo_all(args, root, run, count):
     if done.returncode != 0:
         print(f"{run}: verti eval failed:\n{done.stderr}", file=sys.stderr)
         sys.exit(1)
-    after = sorted(lines(work / "results.jsonl"), key=lambda lr: lr[1]["task"])
+    after = sorted(lines(out / "results.jsonl"), key=lambda lr: lr[1]["task"])
     if len(after) != count:
         print(f"{run}: {len(after)} results after, {count} before", file=sys.stderr)
         sys.exit(1)
     with (run / "results.jsonl").open("w") as f:
         f.writelines(line for line, _ in after)
-    shutil.copyfile(work / "run.json", run / "run.json")
-    shutil.rmtree(work)
-    print(f"{run}: all {count} tasks in {time.time() - start:.0f} s", flush=True)
 
 
 if __name__ == "__main__":
