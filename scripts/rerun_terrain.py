@@ -134,6 +134,12 @@ def redo_all(args, root, run, count):
     resume_into(args, root, run, work, count)
     shutil.copyfile(work / "run.json", run / "run.json")
     shutil.rmtree(work)
+    # Leave no empty folders behind (benchmarks/in-progress/vb80/ once its last run is moved).
+    holder = root / "benchmarks" / "in-progress"
+    parent = work.parent
+    while parent != holder and not any(parent.iterdir()):
+        parent.rmdir()
+        parent = parent.parent
     print(f"{run}: all {count} tasks in {time.time() - start:.0f} s", flush=True)
 
 
