@@ -10,6 +10,9 @@
 #   LIST      e.g. benchmarks/in-progress/before-roll-centres.txt
 #   --commit  commit each finished run with its pages (only the paths this script wrote)
 #   --max N   stop after N runs (default: the whole list)
+#   --every M regenerate the pages (and commit) only once M minutes have passed since the last
+#             time, and after the last run (default 0: after every run); a run of a few seconds
+#             then does not cost a minute of regeneration
 #
 # PIETRA's navigation runs (benchmarks/pietra-nav/*) are one `verti pietra navigate` of all
 # methods and risk levels: the first of them in the list re-runs all of them, with the table
@@ -19,10 +22,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 commit=0
 max=1000000
+every=0
 while [ $# -gt 2 ]; do
     case "$1" in
     --commit) commit=1; shift ;;
     --max) max="$2"; shift 2 ;;
+    --every) every="$2"; shift 2 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
     esac
 done
@@ -33,6 +38,24 @@ list="$2"
 [ -f "$list" ] || { echo "$list: no such list" >&2; exit 2; }
 
 done_runs=0
+pending=()          # runs finished since the pages were last regenerated
+last_regen=$(date +%s)
+regenerate() {
+    [ "${#pending[@]}" -gt 0 ] || return 0
+    bash scripts/benchmarks.sh pack >/dev/null
+    python3 scripts/gen_results.py "$bin" >/dev/null
+    bash scripts/figures.sh >/dev/null
+    if [ "$commit" = 1 ]; then
+        local what="${pending[*]}"
+        [ "${#pending[@]}" -le 3 ] || what="${#pending[@]} runs: ${pending[*]}"
+        git add -A "${paths[@]}" "$list" docs/src/results docs/src/images benchmarks/in-progress
+        git commit -q -m "Re-run after $(basename "$list" .txt): $what; pages and figures regenerated"
+    fi
+    pending=()
+    paths=()
+    last_regen=$(date +%s)
+}
+paths=()
 while [ "$done_runs" -lt "$max" ]; do
     run=$(grep -v '^#' "$list" | grep -v '^[[:space:]]*$' | head -n 1 || true)
     [ -n "$run" ] || { echo "$list: nothing left"; break; }
@@ -50,23 +73,21 @@ while [ "$done_runs" -lt "$max" ]; do
         mv "$work/table.md" "$work/fig7.png" benchmarks/pietra-nav/
         rmdir "$work"
         grep -v '^benchmarks/pietra-nav/' "$list" >"$list.new"
-        paths=(benchmarks/pietra-nav)
+        paths+=(benchmarks/pietra-nav)
         ;;
     *)
         python3 scripts/rerun_terrain.py --bin "$bin" --all "$run"
         grep -vxF "$run" "$list" >"$list.new"
-        paths=("$run")
+        paths+=("$run")
         ;;
     esac
     mv "$list.new" "$list"
     minutes=$((($(date +%s) - start) / 60))
-    bash scripts/benchmarks.sh pack >/dev/null
-    python3 scripts/gen_results.py "$bin" >/dev/null
-    bash scripts/figures.sh >/dev/null
     done_runs=$((done_runs + 1))
     echo "   $run re-run in $minutes min"
-    if [ "$commit" = 1 ]; then
-        git add "${paths[@]}" "$list" docs/src/results docs/src/images
-        git commit -q -m "Re-run after $(basename "$list" .txt): $run ($minutes min); pages and figures regenerated"
+    pending+=("$run ($minutes min)")
+    if [ $(($(date +%s) - last_regen)) -ge $((every * 60)) ]; then
+        regenerate
     fi
 done
+regenerate
