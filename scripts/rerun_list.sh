@@ -17,7 +17,8 @@
 # PIETRA's navigation runs (benchmarks/pietra-nav/*) are one `verti pietra navigate` of all
 # methods and risk levels: the first of them in the list re-runs all of them, with the table
 # and Fig. 7, and drops them all. Stop it at any time: the run under way resumes on the next
-# call (`bash scripts/benchmarks.sh checkpoint` commits it as it stands).
+# call (`bash scripts/benchmarks.sh checkpoint` commits it as it stands). VertiAdaptor's MAML*
+# run (benchmarks/va-nav/maml) first writes its per-world cards again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 commit=0
@@ -74,6 +75,16 @@ while [ "$done_runs" -lt "$max" ]; do
         rmdir "$work"
         grep -v '^benchmarks/pietra-nav/' "$list" >"$list.new"
         paths+=(benchmarks/pietra-nav)
+        ;;
+    benchmarks/va-nav/maml)
+        # MAML*'s per-world cards come from exploration drives with the vehicle, so they are
+        # written again (about 12 min) before the run that reads them (vertiadaptor.md).
+        rm -rf benchmarks/va-nav/maml-cards
+        "$bin" learn va --adapt-to verti-100 --adapt-worlds 1,2,4,5,7,6,8,10,12,13,3,9,20,21,22 \
+            --adapt-out benchmarks/va-nav/maml-cards
+        python3 scripts/rerun_terrain.py --bin "$bin" --all "$run"
+        grep -vxF "$run" "$list" >"$list.new"
+        paths+=("$run")
         ;;
     *)
         python3 scripts/rerun_terrain.py --bin "$bin" --all "$run"
