@@ -18,7 +18,8 @@
 # methods and risk levels: the first of them in the list re-runs all of them, with the table
 # and Fig. 7, and drops them all. Stop it at any time: the run under way resumes on the next
 # call (`bash scripts/benchmarks.sh checkpoint` commits it as it stands). VertiAdaptor's MAML*
-# run (benchmarks/va-nav/maml) first writes its per-world cards again.
+# run (benchmarks/va-nav/maml) first writes its per-world cards again, which needs a BIN built
+# with the `learn` feature (cargo build --release -p verti-cli --features learn).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 commit=0
