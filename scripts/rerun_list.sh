@@ -77,17 +77,14 @@ while [ "$done_runs" -lt "$max" ]; do
         grep -v '^benchmarks/pietra-nav/' "$list" >"$list.new"
         paths+=(benchmarks/pietra-nav)
         ;;
-    benchmarks/va-nav/maml)
-        # MAML*'s per-world cards come from exploration drives with the vehicle, so they are
-        # written again (about 12 min) before the run that reads them (vertiadaptor.md).
-        rm -rf benchmarks/va-nav/maml-cards
-        "$bin" learn va --adapt-to verti-100 --adapt-worlds 1,2,4,5,7,6,8,10,12,13,3,9,20,21,22 \
-            --adapt-out benchmarks/va-nav/maml-cards
-        python3 scripts/rerun_terrain.py --bin "$bin" --all "$run"
-        grep -vxF "$run" "$list" >"$list.new"
-        paths+=("$run")
-        ;;
     *)
+        if [ "$run" = benchmarks/va-nav/maml ]; then
+            # MAML*'s per-world cards come from exploration drives with the vehicle, so they are
+            # written again (about 12 min) before the run that reads them (vertiadaptor.md).
+            rm -rf benchmarks/va-nav/maml-cards
+            "$bin" learn va --adapt-to verti-100 --adapt-worlds 1,2,4,5,7,6,8,10,12,13,3,9,20,21,22 \
+                --adapt-out benchmarks/va-nav/maml-cards
+        fi
         python3 scripts/rerun_terrain.py --bin "$bin" --all "$run"
         grep -vxF "$run" "$list" >"$list.new"
         paths+=("$run")
